@@ -1,0 +1,52 @@
+#include "services/perception/geometry/pose_buffer.h"
+
+#include <algorithm>
+
+namespace mbslam {
+
+const char* InterpolationResultName(InterpolationResult result) {
+  switch (result) {
+    case InterpolationResult::kOk: return "ok";
+    case InterpolationResult::kEmpty: return "no samples";
+    case InterpolationResult::kBeforeFirst: return "before the first sample";
+    case InterpolationResult::kAfterLast: return "after the last sample";
+    case InterpolationResult::kGapTooLarge: return "gap between samples too large";
+  }
+  return "unknown";
+}
+
+Status PoseBuffer::Insert(int64_t utime, const Rigid3d& pose) {
+  if (!pose.IsFinite()) return Status::Error("non-finite pose");
+  if (std::abs(pose.rotation.norm() - 1.0) > 1e-3) return Status::Error("quaternion not unit");
+  if (!samples_.empty() && utime <= samples_.back().utime) {
+    return Status::Error("time did not increase (" + std::to_string(utime) + " after " +
+                         std::to_string(samples_.back().utime) + ")");
+  }
+  samples_.push_back(StampedPose{utime, pose});
+  while (samples_.size() > max_samples_) samples_.pop_front();
+  return Status::Ok();
+}
+
+InterpolationResult PoseBuffer::Interpolate(int64_t utime, Rigid3d* pose) const {
+  if (samples_.empty()) return InterpolationResult::kEmpty;
+  if (utime < samples_.front().utime) return InterpolationResult::kBeforeFirst;
+  if (utime > samples_.back().utime) return InterpolationResult::kAfterLast;
+  auto upper = std::lower_bound(samples_.begin(), samples_.end(), utime,
+                                [](const StampedPose& s, int64_t t) { return s.utime < t; });
+  if (upper->utime == utime) {
+    *pose = upper->pose;
+    return InterpolationResult::kOk;
+  }
+  const StampedPose& b = *upper;
+  const StampedPose& a = *(upper - 1);
+  if (b.utime - a.utime > max_gap_us_) return InterpolationResult::kGapTooLarge;
+  const double t = static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime);
+  *pose = Rigid3d::Interpolate(a.pose, b.pose, t);
+  return InterpolationResult::kOk;
+}
+
+void PoseBuffer::PruneBefore(int64_t utime) {
+  while (samples_.size() >= 2 && samples_[1].utime <= utime) samples_.pop_front();
+}
+
+}  // namespace mbslam
