@@ -11,6 +11,7 @@
 #include <functional>
 #include <list>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -37,11 +38,14 @@ class LcmBus {
   // messages LCM buffers for this subscription before it drops (LCM's default is 30).
   void Subscribe(const std::string& channel, RawHandler handler, int queue_capacity = 30);
 
+  // Thread-safe.
   template <typename Msg>
   int Publish(const std::string& channel, const Msg& msg) {
+    std::lock_guard<std::mutex> lock(publish_mutex_);
     return lcm_->publish(channel, &msg);
   }
   int PublishRaw(const std::string& channel, const void* data, unsigned size) {
+    std::lock_guard<std::mutex> lock(publish_mutex_);
     return lcm_->publish(channel, data, size);
   }
 
@@ -65,6 +69,7 @@ class LcmBus {
 
   std::unique_ptr<lcm::LCM> lcm_;
   std::string url_;
+  std::mutex publish_mutex_;
   std::list<Subscription> subscriptions_;  // stable addresses for the C callback
   std::vector<lcm_subscription_t*> handles_;
 };

@@ -1,0 +1,68 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_PERCEPTION_OPTIONS_H_
+#define MBSLAM_SERVICES_PERCEPTION_PERCEPTION_OPTIONS_H_
+
+// Every option of perception_service, one section per module. config/perception.yaml
+// lists them all with their defaults (a test keeps the two in step).
+
+#include <string>
+
+#include "common/config/options.h"
+#include "common/lcm/channels.h"
+#include "services/perception/lcm_adapters/input_adapter.h"
+#include "services/perception/pipeline/perception_core.h"
+#include "services/perception/pipeline/pipeline_options.h"
+
+namespace mbslam {
+
+struct ServiceOptions {
+  std::string lcm_url;              // LCM URL; "" = LCM_DEFAULT_URL or LCM's udpm default (ttl=0)
+  std::string log_level = "info";   // debug | info | warning | error
+  std::string output_dir;           // trajectories, map, occupancy and summary are written here on exit / snapshot; "" = none
+  std::string output_log;           // every output message also goes to this LCM log, stamped with message time; "" = none
+  bool publish_tracks = true;       // publish the debug PERCEPTION_TRACKS channel
+  bool exit_at_end_of_log = true;   // with a file:// URL, stop when the log ends
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION(log_level == "debug" || log_level == "info" || log_level == "warning" ||
+                        log_level == "error");
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("lcm_url", &lcm_url, "LCM URL; \"\" = LCM_DEFAULT_URL or LCM's udpm default (ttl=0)");
+    v("log_level", &log_level, "debug | info | warning | error");
+    v("output_dir", &output_dir, "outputs written here on exit / snapshot request (\"\" = none)");
+    v("output_log", &output_log, "LCM log of all outputs, stamped with message time (\"\" = none)");
+    v("publish_tracks", &publish_tracks, "publish the debug PERCEPTION_TRACKS channel");
+    v("exit_at_end_of_log", &exit_at_end_of_log, "with a file:// URL, stop at the end of the log");
+  }
+};
+
+struct PerceptionOptions {
+  ServiceOptions service;
+  ChannelOptions channels;
+  PipelineOptions pipeline;
+  InputOptions input;
+  PreprocessOptions preprocess;
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION_SECTION(service);
+    MBSLAM_CHECK_OPTION_SECTION(channels);
+    MBSLAM_CHECK_OPTION_SECTION(pipeline);
+    MBSLAM_CHECK_OPTION_SECTION(input);
+    MBSLAM_CHECK_OPTION_SECTION(preprocess);
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("service", &service, "process-level settings");
+    v("channels", &channels, "LCM channel names");
+    v("pipeline", &pipeline, "threads, queues and the frame-drop policy");
+    v("input", &input, "input message handling and calibration");
+    v("preprocess", &preprocess, "image pyramid and odometry buffer");
+  }
+};
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_PERCEPTION_OPTIONS_H_

@@ -1,0 +1,115 @@
+#include "services/perception/perception_service.h"
+
+#include "common/util/logging.h"
+#include "common/util/shutdown.h"
+#include "common/util/time.h"
+
+namespace mbslam {
+
+PerceptionService::PerceptionService(const PerceptionOptions& options) : options_(options) {}
+
+std::unique_ptr<PerceptionService> PerceptionService::Create(const PerceptionOptions& options,
+                                                             Status* status, LcmBus* bus) {
+  if (!options.Check()) {
+    *status = Status::Error(LastOptionError());
+    return nullptr;
+  }
+  std::unique_ptr<PerceptionService> s(new PerceptionService(options));
+  if (bus == nullptr) {
+    s->owned_bus_ = LcmBus::Create(options.service.lcm_url, status);
+    if (!s->owned_bus_) return nullptr;
+    bus = s->owned_bus_.get();
+  }
+  s->bus_ = bus;
+  if (!options.service.output_log.empty()) {
+    s->output_log_ = LcmLogWriter::Open(options.service.output_log, status);
+    if (!s->output_log_) return nullptr;
+  }
+  s->core_ = std::make_unique<PerceptionCore>(options.preprocess, &s->counters_, &s->timers_);
+  s->lcm_sink_ = std::make_unique<LcmOutputSink>(bus, s->output_log_.get(), options.channels,
+                                                 options.service.publish_tracks);
+  s->sink_ = std::make_unique<TeeSink>(std::vector<OutputSink*>{s->lcm_sink_.get(), &s->recorder_});
+  s->pipeline_ = std::make_unique<PerceptionPipeline>(options.pipeline, s->core_.get(),
+                                                      s->sink_.get(), &s->counters_, &s->timers_);
+  s->adapter_ = InputAdapter::Create(options.input, options.pipeline, s->pipeline_.get(),
+                                     &s->counters_, status);
+  if (!s->adapter_) return nullptr;
+  PerceptionService* self = s.get();
+  s->adapter_->set_snapshot_callback([self](const std::string& prefix, int what) {
+    if (what & 4) self->WriteOutputs(prefix.empty() ? self->options_.service.output_dir : prefix);
+  });
+  s->adapter_->Subscribe(bus, options.channels);
+  s->from_log_ = options.service.lcm_url.rfind("file://", 0) == 0;
+  s->last_status_wall_ = WallUtime();
+  s->pipeline_->Start();
+  *status = Status::Ok();
+  return s;
+}
+
+PerceptionService::~PerceptionService() { Finish(); }
+
+Status PerceptionService::WriteOutputs(const std::string& dir) {
+  if (dir.empty()) return Status::Ok();
+  std::string counters;
+  for (const auto& [name, value] : counters_.Snapshot()) {
+    counters += (counters.empty() ? "" : ", ") + ("\"" + name + "\": " + std::to_string(value));
+  }
+  const Status s = recorder_.Write(dir, "\"counters\": {" + counters + "}");
+  if (!s.ok()) MBSLAM_LOG(ERROR) << "writing outputs to " << dir << ": " << s.message();
+  else MBSLAM_LOG(INFO) << "outputs written to " << dir;
+  return s;
+}
+
+void PerceptionService::MaybePublishStatus() {
+  const int64_t now_wall = WallUtime();
+  const int64_t now_utime = adapter_->last_image_utime();
+  const int64_t period = options_.pipeline.status_period_us;
+  // 1 Hz of message time while images flow; 1 Hz of wall time when they do not, so a
+  // dead camera is reported as STALLED.
+  const bool by_message_time = now_utime != 0 && now_utime - last_status_utime_ >= period;
+  const bool by_wall_time = now_wall - last_status_wall_ >= period && (!from_log_ || now_utime == 0);
+  if (!by_message_time && !by_wall_time) return;
+  last_status_ = pipeline_->BuildStatus(now_wall);
+  lcm_sink_->PublishStatus(last_status_);
+  last_status_utime_ = now_utime;
+  last_status_wall_ = now_wall;
+}
+
+bool PerceptionService::RunOnce(int timeout_ms) {
+  const int handled = bus_->HandleTimeout(timeout_ms);
+  MaybePublishStatus();
+  if (handled < 0) {
+    if (from_log_ && options_.service.exit_at_end_of_log) return false;
+    MBSLAM_LOG(ERROR) << "LCM handle failed";
+  }
+  return true;
+}
+
+Status PerceptionService::Run() {
+  MBSLAM_LOG(INFO) << "running on "
+                   << (options_.service.lcm_url.empty() ? "the LCM default URL" : options_.service.lcm_url)
+                   << " in " << options_.pipeline.mode << " mode";
+  while (!shutdown_ && !ShutdownRequested()) {
+    if (!RunOnce(50)) break;
+  }
+  MBSLAM_LOG(INFO) << "stopping" << (ShutdownSignal() ? " on signal" : "");
+  return Finish();
+}
+
+Status PerceptionService::Finish() {
+  if (finished_) return Status::Ok();
+  finished_ = true;
+  pipeline_->Stop();
+  last_status_ = pipeline_->BuildStatus(WallUtime());
+  lcm_sink_->PublishStatus(last_status_);
+  if (output_log_) output_log_->Flush();
+  MBSLAM_LOG(INFO) << "frames received " << last_status_.frames_received << ", processed "
+                   << last_status_.frames_processed << ", dropped " << last_status_.frames_dropped
+                   << ", rejected " << last_status_.frames_rejected;
+  for (const auto& [name, value] : last_status_.counters) {
+    MBSLAM_LOG(INFO) << "  " << name << ": " << value;
+  }
+  return WriteOutputs(options_.service.output_dir);
+}
+
+}  // namespace mbslam

@@ -1,0 +1,68 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_PIPELINE_COUNTERS_H_
+#define MBSLAM_SERVICES_PERCEPTION_PIPELINE_COUNTERS_H_
+
+// Named, cumulative event counters (input errors, drops, recoveries) reported on
+// PERCEPTION_STATUS. Thread-safe.
+
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace mbslam {
+
+class Counters {
+ public:
+  void Increment(const std::string& name, int64_t by = 1) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    values_[name] += by;
+    last_event_ = name;
+  }
+  int64_t Get(const std::string& name) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = values_.find(name);
+    return it == values_.end() ? 0 : it->second;
+  }
+  // Sorted by name.
+  std::vector<std::pair<std::string, int64_t>> Snapshot() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return {values_.begin(), values_.end()};
+  }
+  std::string last_event() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return last_event_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, int64_t> values_;
+  std::string last_event_;
+};
+
+// Counter names used across the service, defined once.
+namespace counter {
+inline constexpr const char* kImageDecodeError = "image_decode_error";          // malformed image_t
+inline constexpr const char* kImageBadSize = "image_bad_size";                  // width/height out of range
+inline constexpr const char* kImageSizeMismatch = "image_size_mismatch";        // byte count != geometry
+inline constexpr const char* kImageUnknownEncoding = "image_unknown_encoding";  // encoding not supported
+inline constexpr const char* kImageDecompressError = "image_decompress_error";  // JPEG/PNG broken
+inline constexpr const char* kImageTimeBackwards = "image_time_backwards";      // utime <= previous
+inline constexpr const char* kImageTimeJump = "image_time_jump";                // gap > max_frame_gap
+inline constexpr const char* kImageSeqGap = "image_frames_lost_upstream";       // seq gaps (frames)
+inline constexpr const char* kImageCalibrationMismatch = "image_calibration_mismatch";
+inline constexpr const char* kImageUncalibrated = "image_uncalibrated";         // used fallback intrinsics
+inline constexpr const char* kImageDroppedStale = "image_dropped_stale";        // realtime policy
+inline constexpr const char* kOdometryDecodeError = "odometry_decode_error";
+inline constexpr const char* kOdometryInvalid = "odometry_invalid";             // NaN / non-unit quaternion
+inline constexpr const char* kOdometryTimeBackwards = "odometry_time_backwards";
+inline constexpr const char* kCalibrationDecodeError = "calibration_decode_error";
+inline constexpr const char* kCalibrationInvalid = "calibration_invalid";
+inline constexpr const char* kSnapshotDecodeError = "snapshot_request_decode_error";
+inline constexpr const char* kStageOverrun = "stage_overrun";
+}  // namespace counter
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_PIPELINE_COUNTERS_H_

@@ -1,0 +1,229 @@
+#include "services/perception/pipeline/pipeline.h"
+
+#include "common/util/logging.h"
+#include "common/util/time.h"
+#include "services/perception/pipeline/image_decode.h"
+
+namespace mbslam {
+
+const char* ServiceStateName(ServiceState state) {
+  switch (state) {
+    case ServiceState::kStarting: return "starting";
+    case ServiceState::kRunning: return "running";
+    case ServiceState::kDegraded: return "degraded";
+    case ServiceState::kStalled: return "stalled";
+    case ServiceState::kStopping: return "stopping";
+  }
+  return "unknown";
+}
+
+const char* TrackingStateName(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNotInitialized: return "not_initialized";
+    case TrackingState::kInitializing: return "initializing";
+    case TrackingState::kOk: return "ok";
+    case TrackingState::kLost: return "lost";
+    case TrackingState::kRelocalized: return "relocalized";
+  }
+  return "unknown";
+}
+
+namespace {
+QueueFullPolicy ImagePolicy(const PipelineOptions& o) {
+  return o.lockstep() ? QueueFullPolicy::kBlock : QueueFullPolicy::kDropOldest;
+}
+}  // namespace
+
+PerceptionPipeline::PerceptionPipeline(const PipelineOptions& options, FrameProcessor* processor,
+                                       OutputSink* sink, Counters* counters, StageTimers* timers)
+    : options_(options),
+      processor_(processor),
+      sink_(sink),
+      counters_(counters),
+      timers_(timers),
+      decode_timer_(timers->Get("decode")),
+      frame_timer_(timers->Get("frame_total", options.frame_budget_ms)),
+      latency_("latency"),
+      input_queue_(options.lockstep() ? options.lockstep_queue_capacity : options.image_queue_capacity,
+                   ImagePolicy(options)),
+      frame_queue_(options.lockstep() ? 4 : 1, ImagePolicy(options)),
+      odometry_queue_(options.aux_queue_capacity, QueueFullPolicy::kDropOldest) {}
+
+PerceptionPipeline::~PerceptionPipeline() { Stop(); }
+
+void PerceptionPipeline::Start() {
+  if (started_) return;
+  started_ = true;
+  period_start_wall_ = WallUtime();
+  decode_thread_ = std::thread([this] { DecodeLoop(); });
+  process_thread_ = std::thread([this] { ProcessLoop(); });
+}
+
+void PerceptionPipeline::Stop() {
+  if (!started_ || stopped_) return;
+  stopped_ = true;
+  if (!options_.lockstep()) {
+    // Realtime: what is still queued will not be processed; count it.
+    int64_t left = 0;
+    while (auto e = input_queue_.TryPop()) {
+      if (std::holds_alternative<RawImage>(*e)) ++left;
+    }
+    if (left > 0) counters_->Increment(counter::kImageDroppedStale, left);
+  }
+  input_queue_.Shutdown();  // the decode thread drains what remains, then ends
+  decode_thread_.join();
+  frame_queue_.Shutdown();
+  odometry_queue_.Shutdown();
+  process_thread_.join();
+  processor_->Finish();
+}
+
+void PerceptionPipeline::Push(InputEvent event) {
+  if (auto* image = std::get_if<RawImage>(&event)) {
+    ++frames_received_;
+    latest_utime_.store(image->utime);
+    last_image_wall_utime_.store(image->receive_wall_utime);
+  } else if (auto* odom = std::get_if<OdometrySample>(&event)) {
+    latest_utime_.store(std::max(latest_utime_.load(), odom->utime));
+    if (!options_.lockstep()) {
+      odometry_queue_.Push(std::move(*odom));
+      return;
+    }
+  }
+  const int64_t dropped_before = input_queue_.dropped();
+  input_queue_.Push(std::move(event));
+  const int64_t dropped = input_queue_.dropped() - dropped_before;
+  if (dropped > 0) counters_->Increment(counter::kImageDroppedStale, dropped);
+}
+
+void PerceptionPipeline::DecodeLoop() {
+  while (auto event = input_queue_.Pop()) {
+    if (auto* odom = std::get_if<OdometrySample>(&*event)) {
+      frame_queue_.Push(FrameEvent(std::move(*odom)));
+      continue;
+    }
+    const RawImage& raw = std::get<RawImage>(*event);
+    ImageFrame frame;
+    Status status;
+    {
+      ScopedStageTimer timer(decode_timer_);
+      status = DecodeImage(raw, /*keep_color=*/true, &frame);
+    }
+    if (!status.ok()) {
+      counters_->Increment(counter::kImageDecompressError);
+      ++frames_rejected_;
+      MBSLAM_LOG(WARNING) << "image seq " << raw.seq << " rejected: " << status.message();
+      continue;
+    }
+    frame.intrinsics = raw.intrinsics;
+    frame.timeline_reset = raw.timeline_reset;
+    const int64_t dropped_before = frame_queue_.dropped();
+    frame_queue_.Push(FrameEvent(std::move(frame)));
+    const int64_t dropped = frame_queue_.dropped() - dropped_before;
+    if (dropped > 0) counters_->Increment(counter::kImageDroppedStale, dropped);
+  }
+}
+
+void PerceptionPipeline::DrainOdometry() {
+  while (auto odom = odometry_queue_.TryPop()) processor_->OnOdometry(*odom);
+}
+
+void PerceptionPipeline::ProcessImage(const ImageFrame& frame) {
+  FrameResult result;
+  {
+    ScopedStageTimer timer(frame_timer_);
+    result = processor_->ProcessFrame(frame);
+  }
+  result.receive_wall_utime = frame.receive_wall_utime;
+  sink_->OnFrameResult(result);
+  ++frames_processed_;
+  if (frame.receive_wall_utime > 0) {
+    latency_.Add(UtimeToMs(WallUtime() - frame.receive_wall_utime));
+  }
+}
+
+void PerceptionPipeline::ProcessLoop() {
+  while (true) {
+    std::optional<FrameEvent> event =
+        options_.lockstep() ? frame_queue_.Pop() : frame_queue_.PopFor(20000);
+    if (!options_.lockstep()) DrainOdometry();
+    if (!event) {
+      if (frame_queue_.is_shutdown()) break;
+      continue;
+    }
+    if (auto* odom = std::get_if<OdometrySample>(&*event)) {
+      processor_->OnOdometry(*odom);
+      continue;
+    }
+    ProcessImage(std::get<ImageFrame>(*event));
+  }
+}
+
+PipelineStatus PerceptionPipeline::BuildStatus(int64_t wall_utime) {
+  PipelineStatus s;
+  s.utime = latest_utime_.load();
+  s.wall_utime = wall_utime;
+  s.lockstep = options_.lockstep();
+  s.frames_received = frames_received_.load();
+  s.frames_processed = frames_processed_.load();
+  s.frames_rejected = frames_rejected_.load();
+  s.frames_dropped = counters_->Get(counter::kImageDroppedStale);
+
+  const double wall_span = UtimeToSeconds(wall_utime - period_start_wall_);
+  if (wall_span > 0.0) {
+    s.processed_fps = static_cast<double>(s.frames_processed - period_start_processed_) / wall_span;
+  }
+  const double msg_span = UtimeToSeconds(s.utime - period_first_utime_);
+  if (period_first_utime_ > 0 && msg_span > 0.0) {
+    s.input_fps = static_cast<double>(s.frames_received - period_start_received_) / msg_span;
+  }
+  period_start_wall_ = wall_utime;
+  period_start_processed_ = s.frames_processed;
+  period_start_received_ = s.frames_received;
+  period_first_utime_ = s.utime;
+
+  const TimingSummary latency = latency_.Drain();
+  s.latency_p50_ms = latency.p50_ms;
+  s.latency_p99_ms = latency.p99_ms;
+  for (TimingStats* stage : timers_->All()) {
+    StageStatus st{stage->name(), stage->Drain()};
+    if (st.timing.overruns > 0) counters_->Increment(counter::kStageOverrun, st.timing.overruns);
+    s.stages.push_back(st);
+  }
+  s.queues.push_back(QueueStatus{"input", static_cast<int>(input_queue_.size()),
+                                 static_cast<int>(input_queue_.capacity()), input_queue_.dropped()});
+  s.queues.push_back(QueueStatus{"frames", static_cast<int>(frame_queue_.size()),
+                                 static_cast<int>(frame_queue_.capacity()), frame_queue_.dropped()});
+  s.queues.push_back(QueueStatus{"odometry", static_cast<int>(odometry_queue_.size()),
+                                 static_cast<int>(odometry_queue_.capacity()),
+                                 odometry_queue_.dropped()});
+  s.counters = counters_->Snapshot();
+
+  const int64_t last_image = last_image_wall_utime_.load();
+  if (stopped_) {
+    s.state = ServiceState::kStopping;
+    s.message = "stopping";
+  } else if (s.frames_received == 0) {
+    s.state = ServiceState::kStarting;
+    s.message = "waiting for images";
+  } else if (!options_.lockstep() && wall_utime - last_image > options_.stall_timeout_us) {
+    s.state = ServiceState::kStalled;
+    s.message = "no image for " + std::to_string((wall_utime - last_image) / 1000) + " ms";
+  } else {
+    // Degraded when an error or drop counter moved during the period.
+    std::string moved;
+    for (const auto& [name, value] : s.counters) {
+      int64_t before = 0;
+      for (const auto& [pname, pvalue] : previous_counters_) {
+        if (pname == name) before = pvalue;
+      }
+      if (value > before) moved += (moved.empty() ? "" : ", ") + name + " +" + std::to_string(value - before);
+    }
+    s.state = moved.empty() ? ServiceState::kRunning : ServiceState::kDegraded;
+    s.message = moved.empty() ? "running" : moved;
+  }
+  previous_counters_ = s.counters;
+  return s;
+}
+
+}  // namespace mbslam

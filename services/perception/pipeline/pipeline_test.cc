@@ -1,0 +1,163 @@
+#include "services/perception/pipeline/pipeline.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <mutex>
+#include <thread>
+
+namespace mbslam {
+namespace {
+
+// Records the order of events it sees; optionally slow.
+class RecordingProcessor : public FrameProcessor {
+ public:
+  explicit RecordingProcessor(int sleep_ms = 0) : sleep_ms_(sleep_ms) {}
+  void OnOdometry(const OdometrySample& o) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    events.push_back("o" + std::to_string(o.utime));
+  }
+  FrameResult ProcessFrame(const ImageFrame& f) override {
+    if (sleep_ms_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(sleep_ms_));
+    std::lock_guard<std::mutex> lock(mutex_);
+    events.push_back("i" + std::to_string(f.utime));
+    EXPECT_EQ(f.gray.cols, 8);
+    FrameResult r;
+    r.utime = f.utime;
+    r.frame_seq = f.seq;
+    return r;
+  }
+  void Finish() override { finished = true; }
+  std::vector<std::string> events;
+  bool finished = false;
+
+ private:
+  int sleep_ms_;
+  std::mutex mutex_;
+};
+
+class CountingSink : public OutputSink {
+ public:
+  void OnFrameResult(const FrameResult& r) override { utimes.push_back(r.utime); }
+  std::vector<int64_t> utimes;
+};
+
+RawImage Image(int64_t utime) {
+  RawImage raw;
+  raw.utime = utime;
+  raw.seq = utime;
+  raw.width = 8;
+  raw.height = 4;
+  raw.row_stride = 8;
+  raw.encoding = ImageEncoding::kGray8;
+  raw.bytes.assign(32, 7);
+  return raw;
+}
+
+OdometrySample Odom(int64_t utime) {
+  OdometrySample o;
+  o.utime = utime;
+  return o;
+}
+
+TEST(Pipeline, LockstepProcessesEveryEventInOrder) {
+  PipelineOptions options;
+  options.mode = "lockstep";
+  options.lockstep_queue_capacity = 2;
+  RecordingProcessor processor(/*sleep_ms=*/1);
+  CountingSink sink;
+  Counters counters;
+  StageTimers timers;
+  PerceptionPipeline pipeline(options, &processor, &sink, &counters, &timers);
+  pipeline.Start();
+  std::vector<std::string> expected;
+  for (int i = 1; i <= 50; ++i) {
+    pipeline.Push(Odom(i * 100 - 50));
+    expected.push_back("o" + std::to_string(i * 100 - 50));
+    pipeline.Push(Image(i * 100));
+    expected.push_back("i" + std::to_string(i * 100));
+  }
+  pipeline.Stop();
+  EXPECT_EQ(processor.events, expected);
+  EXPECT_EQ(sink.utimes.size(), 50u);
+  EXPECT_TRUE(processor.finished);
+  EXPECT_EQ(pipeline.frames_processed(), 50);
+  EXPECT_EQ(counters.Get(counter::kImageDroppedStale), 0);
+}
+
+TEST(Pipeline, RealtimeDropsStaleFramesAndCountsThem) {
+  PipelineOptions options;
+  options.mode = "realtime";
+  options.image_queue_capacity = 1;
+  RecordingProcessor processor(/*sleep_ms=*/20);
+  CountingSink sink;
+  Counters counters;
+  StageTimers timers;
+  PerceptionPipeline pipeline(options, &processor, &sink, &counters, &timers);
+  pipeline.Start();
+  for (int i = 1; i <= 40; ++i) {
+    pipeline.Push(Image(i * 1000));
+    pipeline.Push(Odom(i * 1000 + 1));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  pipeline.Stop();
+  const int64_t processed = pipeline.frames_processed();
+  const int64_t dropped = counters.Get(counter::kImageDroppedStale);
+  EXPECT_LT(processed, 40);
+  EXPECT_GT(dropped, 0);
+  EXPECT_EQ(processed + dropped, 40) << "every frame is either processed or counted";
+  // Odometry is never dropped by the image policy.
+  int odometry = 0;
+  for (const auto& e : processor.events) odometry += e[0] == 'o';
+  EXPECT_EQ(odometry, 40);
+  // The newest frame survives.
+  EXPECT_EQ(sink.utimes.back(), 40000);
+}
+
+TEST(Pipeline, BadImageIsCountedNotFatal) {
+  PipelineOptions options;
+  options.mode = "lockstep";
+  RecordingProcessor processor;
+  CountingSink sink;
+  Counters counters;
+  StageTimers timers;
+  PerceptionPipeline pipeline(options, &processor, &sink, &counters, &timers);
+  pipeline.Start();
+  RawImage broken = Image(1);
+  broken.encoding = ImageEncoding::kJpeg;  // bytes are not a JPEG
+  pipeline.Push(broken);
+  pipeline.Push(Image(2));
+  pipeline.Stop();
+  EXPECT_EQ(counters.Get(counter::kImageDecompressError), 1);
+  EXPECT_EQ(pipeline.frames_processed(), 1);
+}
+
+TEST(Pipeline, StatusReportsStagesQueuesAndDegradation) {
+  PipelineOptions options;
+  options.mode = "lockstep";
+  RecordingProcessor processor;
+  CountingSink sink;
+  Counters counters;
+  StageTimers timers;
+  PerceptionPipeline pipeline(options, &processor, &sink, &counters, &timers);
+  PipelineStatus s0 = pipeline.BuildStatus(1);
+  EXPECT_EQ(s0.state, ServiceState::kStarting);
+  pipeline.Start();
+  for (int i = 1; i <= 5; ++i) pipeline.Push(Image(i * 33333));
+  pipeline.Stop();
+  counters.Increment(counter::kImageTimeBackwards);
+  PipelineStatus s = pipeline.BuildStatus(2);
+  EXPECT_EQ(s.frames_received, 5);
+  EXPECT_EQ(s.frames_processed, 5);
+  EXPECT_EQ(s.queues.size(), 3u);
+  bool has_decode = false;
+  for (const auto& st : s.stages) has_decode |= st.name == "decode" && st.timing.count == 5;
+  EXPECT_TRUE(has_decode);
+  EXPECT_EQ(s.state, ServiceState::kStopping);
+  bool counted = false;
+  for (const auto& [n, v] : s.counters) counted |= n == counter::kImageTimeBackwards && v == 1;
+  EXPECT_TRUE(counted);
+}
+
+}  // namespace
+}  // namespace mbslam

@@ -1,0 +1,41 @@
+#include "services/perception/pipeline/result_recorder.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "common/util/atomic_file.h"
+
+namespace mbslam {
+namespace {
+
+TEST(ResultRecorder, TumLineFormat) {
+  Rigid3d pose(Eigen::Quaterniond(1, 0, 0, 0), Eigen::Vector3d(1.5, -2, 3));
+  EXPECT_EQ(TumLine(1234567890, pose),
+            "1234.567890 1.500000000 -2.000000000 3.000000000 0.000000000 0.000000000 0.000000000 1.000000000");
+}
+
+TEST(ResultRecorder, WritesTrackedPosesAndSummary) {
+  ResultRecorder recorder;
+  for (int i = 0; i < 4; ++i) {
+    FrameResult r;
+    r.utime = 1000000 + i * 100000;
+    r.camera_pose.utime = r.utime;
+    r.camera_pose.tracking_state = i == 0 ? TrackingState::kInitializing : TrackingState::kOk;
+    r.camera_pose.world_from_cam.translation.x() = i;
+    recorder.OnFrameResult(r);
+  }
+  char pattern[] = "/tmp/mbslam_rec_XXXXXX";
+  const std::string dir = mkdtemp(pattern);
+  ASSERT_TRUE(recorder.Write(dir, "\"note\": 1").ok());
+  std::string traj, summary;
+  ASSERT_TRUE(ReadFileToString(dir + "/camera_trajectory.tum", &traj).ok());
+  ASSERT_TRUE(ReadFileToString(dir + "/summary.json", &summary).ok());
+  int lines = 0;
+  for (char c : traj) lines += c == '\n';
+  EXPECT_EQ(lines, 4);  // header + 3 tracked
+  EXPECT_NE(summary.find("\"tracked_fraction\": 0.75"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"note\": 1"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mbslam
