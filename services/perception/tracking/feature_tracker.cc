@@ -1,0 +1,397 @@
+#include "services/perception/tracking/feature_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "services/perception/tracking/patch_matcher.h"
+
+namespace mbslam {
+
+bool InsideConvexHull(const std::vector<Eigen::Vector2f>& hull, const Eigen::Vector2f& p) {
+  if (hull.size() < 3) return false;
+  int sign = 0;
+  for (size_t i = 0; i < hull.size(); ++i) {
+    const Eigen::Vector2f& a = hull[i];
+    const Eigen::Vector2f& b = hull[(i + 1) % hull.size()];
+    const float cross = (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
+    const int s = cross > 0.0f ? 1 : (cross < 0.0f ? -1 : 0);
+    if (s == 0) continue;
+    if (sign == 0) sign = s;
+    else if (s != sign) return false;
+  }
+  return true;
+}
+
+std::vector<Eigen::Vector2f> ConvexHull(std::vector<Eigen::Vector2f> pts) {
+  // Andrew's monotone chain.
+  std::sort(pts.begin(), pts.end(), [](const Eigen::Vector2f& a, const Eigen::Vector2f& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  if (pts.size() < 3) return pts;
+  auto cross = [](const Eigen::Vector2f& o, const Eigen::Vector2f& a, const Eigen::Vector2f& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::vector<Eigen::Vector2f> hull(2 * pts.size());
+  size_t k = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  for (size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], pts[i - 1]) <= 0) --k;
+    hull[k++] = pts[i - 1];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+FeatureTracker::FeatureTracker(const TrackerOptions& options) : options_(options) {}
+
+void FeatureTracker::Reset() {
+  tracks_.clear();
+  recently_lost_.clear();
+  prev_pyramid_.clear();
+}
+
+namespace {
+
+bool InBorder(const Eigen::Vector2f& uv, const cv::Mat& image, float border) {
+  return uv.x() >= border && uv.y() >= border && uv.x() <= image.cols - 1 - border &&
+         uv.y() <= image.rows - 1 - border;
+}
+
+}  // namespace
+
+void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t frame_index,
+                           const TrackingHints& hints) {
+  stats_ = TrackerStats();
+  frame_index_ = frame_index;
+  recently_lost_.clear();
+  const cv::Mat& image = pyramid[0];
+  if (prev_pyramid_.empty()) {
+    tracks_.clear();
+    DetectNew(image, frame_index);
+    prev_pyramid_ = pyramid;
+    return;
+  }
+
+  const float border = static_cast<float>(options_.border_px);
+  std::vector<Track> next_tracks;
+  next_tracks.reserve(tracks_.size() + 64);
+  std::vector<size_t> klt_index;  // into tracks_
+  std::vector<cv::Point2f> prev_pts, next_pts;
+  std::vector<std::pair<size_t, Eigen::Vector2f>> reappearing;  // occluded, predicted visible
+
+  // Occlusion and predictions.
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    Track& t = tracks_[i];
+    t.is_new = false;
+    auto it = hints.predicted_uv.find(t.id);
+    const Eigen::Vector2f pred =
+        it != hints.predicted_uv.end() ? it->second : Eigen::Vector2f(t.uv + t.velocity);
+    if (!pred.allFinite()) continue;
+    bool occluded = false;
+    for (const TrackingHints::Hull& h : hints.occluders) {
+      if (h.body_id != t.body_id && InsideConvexHull(h.points, pred)) {
+        occluded = true;
+        break;
+      }
+    }
+    if (occluded) {
+      if (t.occluded_frames >= options_.max_occluded_frames || !InBorder(pred, image, border)) continue;
+      t.status = TrackStatus::kOccluded;
+      ++t.occluded_frames;
+      t.prev_uv = t.uv;
+      t.uv = pred;
+      ++stats_.occluded;
+      next_tracks.push_back(std::move(t));
+      continue;
+    }
+    if (t.status == TrackStatus::kOccluded) {
+      reappearing.emplace_back(i, pred);
+      continue;
+    }
+    klt_index.push_back(i);
+    prev_pts.emplace_back(t.uv.x(), t.uv.y());
+    next_pts.emplace_back(pred.x(), pred.y());
+  }
+
+  // Stage 1: KLT from the predicted positions, forward then backward.
+  const cv::Size win(options_.klt_window_px, options_.klt_window_px);
+  const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                              options_.klt_max_iterations, options_.klt_epsilon);
+  const int max_level = options_.klt_levels - 1;
+  std::vector<uint8_t> status, back_status;
+  std::vector<float> err;
+  std::vector<cv::Point2f> back_pts;
+  if (!prev_pts.empty()) {
+    cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, prev_pts, next_pts, status, err, win,
+                             max_level, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+    // Wide search: a failed prediction (a body that changed its motion) is retried
+    // from the previous position.
+    std::vector<size_t> retry;
+    std::vector<cv::Point2f> retry_prev, retry_next;
+    for (size_t k = 0; k < prev_pts.size(); ++k) {
+      const cv::Point2f guess_offset = next_pts[k] - prev_pts[k];
+      if (!status[k] && guess_offset.dot(guess_offset) > 1.0f) {
+        retry.push_back(k);
+        retry_prev.push_back(prev_pts[k]);
+        retry_next.push_back(prev_pts[k]);
+      }
+    }
+    if (!retry.empty()) {
+      std::vector<uint8_t> rs;
+      std::vector<float> re;
+      cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, retry_prev, retry_next, rs, re, win,
+                               max_level, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+      for (size_t r = 0; r < retry.size(); ++r) {
+        if (rs[r]) {
+          status[retry[r]] = 1;
+          next_pts[retry[r]] = retry_next[r];
+        }
+      }
+    }
+    back_pts = prev_pts;
+    cv::calcOpticalFlowPyrLK(pyramid, prev_pyramid_, next_pts, back_pts, back_status, err, win,
+                             max_level, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+  }
+
+  const float fb2 = static_cast<float>(options_.max_forward_backward_px *
+                                       options_.max_forward_backward_px);
+  const float a = static_cast<float>(options_.velocity_smoothing);
+  for (size_t k = 0; k < prev_pts.size(); ++k) {
+    Track& t = tracks_[klt_index[k]];
+    const Eigen::Vector2f next(next_pts[k].x, next_pts[k].y);
+    const cv::Point2f d = back_pts[k] - prev_pts[k];
+    const float fb = d.dot(d);
+    const bool ok = status[k] && back_status[k] && fb <= fb2 && next.allFinite() &&
+                    InBorder(next, image, border);
+    if (!ok) {
+      ++stats_.lost;
+      recently_lost_.push_back(std::move(t));
+      continue;
+    }
+    cv::Mat patch;
+    if (!ExtractPatch(image, next, options_.patch_size, &patch) ||
+        (!t.patch.empty() && PatchNcc(patch, t.patch) < options_.min_patch_ncc)) {
+      ++stats_.lost;
+      recently_lost_.push_back(std::move(t));
+      continue;
+    }
+    const Eigen::Vector2f flow = next - t.uv;
+    t.velocity = t.age > 1 ? Eigen::Vector2f(a * flow + (1.0f - a) * t.velocity) : flow;
+    t.prev_uv = t.uv;
+    t.uv = next;
+    t.match_error = std::sqrt(fb);
+    ++t.age;
+    t.last_seen_frame = frame_index;
+    t.occluded_frames = 0;
+    t.patch = patch;
+    ++stats_.tracked;
+    next_tracks.push_back(std::move(t));
+  }
+
+  // Tracks coming out from behind a hull: re-found on their template.
+  for (auto& [i, pred] : reappearing) {
+    Track& t = tracks_[i];
+    if (t.patch.empty() || !InBorder(pred, image, border)) continue;
+    const PatchMatch m = FindPatchZssd(image, t.patch, pred, options_.guided_radius_px);
+    if (!m.found || m.score > options_.max_patch_score || m.second < 1.5f * m.score) {
+      ++stats_.lost;
+      continue;
+    }
+    t.prev_uv = t.uv;
+    t.uv = m.uv;
+    t.status = TrackStatus::kActive;
+    t.occluded_frames = 0;
+    t.match_error = 0.0f;
+    ++t.age;
+    t.last_seen_frame = frame_index;
+    ExtractPatch(image, t.uv, options_.patch_size, &t.patch);
+    ++stats_.recovered;
+    next_tracks.push_back(std::move(t));
+  }
+
+  tracks_ = std::move(next_tracks);
+  EnforceUnicity();
+  prev_pyramid_ = pyramid;
+  DetectNew(image, frame_index);
+}
+
+int FeatureTracker::GuidedMatch(const std::unordered_map<int64_t, Eigen::Vector2f>& predicted_uv) {
+  if (prev_pyramid_.empty()) return 0;
+  const cv::Mat& image = prev_pyramid_[0];  // the latest image
+  const float border = static_cast<float>(options_.border_px);
+  int found = 0;
+  std::vector<Track> still_lost;
+  for (Track& t : recently_lost_) {
+    auto it = predicted_uv.find(t.id);
+    if (it == predicted_uv.end() || t.patch.empty() || !InBorder(it->second, image, border)) {
+      still_lost.push_back(std::move(t));
+      continue;
+    }
+    const PatchMatch m = FindPatchZssd(image, t.patch, it->second, options_.guided_radius_px);
+    if (!m.found || m.score > options_.max_patch_score || m.second < 1.5f * m.score) {
+      still_lost.push_back(std::move(t));
+      continue;
+    }
+    t.prev_uv = t.uv;
+    t.uv = m.uv;
+    t.status = TrackStatus::kActive;
+    t.occluded_frames = 0;
+    ++t.age;
+    t.last_seen_frame = frame_index_;
+    ExtractPatch(image, t.uv, options_.patch_size, &t.patch);
+    tracks_.push_back(std::move(t));
+    ++found;
+  }
+  recently_lost_ = std::move(still_lost);
+  stats_.recovered += found;
+  if (found > 0) EnforceUnicity();
+  return found;
+}
+
+void FeatureTracker::EnforceUnicity() {
+  if (options_.unicity_px <= 0.0) return;
+  const float cell = static_cast<float>(std::max(1.0, options_.unicity_px));
+  // Better tracks first: older, then smaller matching error.
+  std::vector<size_t> order(tracks_.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    if (tracks_[a].active() != tracks_[b].active()) return tracks_[a].active();
+    if (tracks_[a].age != tracks_[b].age) return tracks_[a].age > tracks_[b].age;
+    return tracks_[a].match_error < tracks_[b].match_error;
+  });
+  std::unordered_map<int64_t, std::vector<size_t>> grid;
+  auto key = [cell](int gx, int gy) { return (static_cast<int64_t>(gx) << 32) ^ static_cast<uint32_t>(gy); };
+  std::vector<bool> keep(tracks_.size(), true);
+  const float r2 = static_cast<float>(options_.unicity_px * options_.unicity_px);
+  for (size_t i : order) {
+    const Track& t = tracks_[i];
+    if (!t.active()) continue;
+    const int gx = static_cast<int>(std::floor(t.uv.x() / cell));
+    const int gy = static_cast<int>(std::floor(t.uv.y() / cell));
+    bool clash = false;
+    for (int dx = -1; dx <= 1 && !clash; ++dx) {
+      for (int dy = -1; dy <= 1 && !clash; ++dy) {
+        auto it = grid.find(key(gx + dx, gy + dy));
+        if (it == grid.end()) continue;
+        for (size_t j : it->second) {
+          if ((tracks_[j].uv - t.uv).squaredNorm() < r2) {
+            clash = true;
+            break;
+          }
+        }
+      }
+    }
+    if (clash) {
+      keep[i] = false;
+      ++stats_.rejected_unicity;
+    } else {
+      grid[key(gx, gy)].push_back(i);
+    }
+  }
+  std::vector<Track> out;
+  out.reserve(tracks_.size());
+  for (size_t i = 0; i < tracks_.size(); ++i) {
+    if (keep[i]) out.push_back(std::move(tracks_[i]));
+  }
+  tracks_ = std::move(out);
+}
+
+void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
+  const int cells = options_.grid_cols * options_.grid_rows;
+  const int room = options_.max_features - static_cast<int>(tracks_.size());
+  if (room <= 0) return;
+  const int per_cell = std::max(1, (options_.max_features + cells - 1) / cells);
+  const float cell_w = static_cast<float>(image.cols) / options_.grid_cols;
+  const float cell_h = static_cast<float>(image.rows) / options_.grid_rows;
+  auto cell_of = [&](float x, float y) {
+    const int cx = std::clamp(static_cast<int>(x / cell_w), 0, options_.grid_cols - 1);
+    const int cy = std::clamp(static_cast<int>(y / cell_h), 0, options_.grid_rows - 1);
+    return cy * options_.grid_cols + cx;
+  };
+
+  // Occupancy: a min-distance disc around every existing track.
+  cv::Mat mask(image.size(), CV_8UC1, cv::Scalar(0));
+  const int b = options_.border_px + 3;  // FAST needs 3 px around a corner
+  if (image.cols > 2 * b && image.rows > 2 * b) {
+    mask(cv::Rect(b, b, image.cols - 2 * b, image.rows - 2 * b)).setTo(255);
+  }
+  const int radius = static_cast<int>(std::ceil(options_.min_distance_px));
+  std::vector<int> count(static_cast<size_t>(cells), 0);
+  for (const Track& t : tracks_) {
+    cv::circle(mask, cv::Point(static_cast<int>(std::lround(t.uv.x())), static_cast<int>(std::lround(t.uv.y()))),
+               radius, cv::Scalar(0), -1);
+    ++count[static_cast<size_t>(cell_of(t.uv.x(), t.uv.y()))];
+  }
+
+  std::vector<cv::KeyPoint> keypoints;
+  cv::FAST(image, keypoints, options_.fast_threshold, /*nonmaxSuppression=*/true);
+  std::vector<std::vector<const cv::KeyPoint*>> by_cell(static_cast<size_t>(cells));
+  for (const cv::KeyPoint& kp : keypoints) {
+    by_cell[static_cast<size_t>(cell_of(kp.pt.x, kp.pt.y))].push_back(&kp);
+  }
+  // Empty cells get a second chance at the lower threshold.
+  std::vector<std::vector<cv::KeyPoint>> extra(static_cast<size_t>(cells));
+  for (int c = 0; c < cells; ++c) {
+    if (!by_cell[static_cast<size_t>(c)].empty() || count[static_cast<size_t>(c)] >= per_cell) continue;
+    const int cx = c % options_.grid_cols, cy = c / options_.grid_cols;
+    const cv::Rect roi(static_cast<int>(cx * cell_w), static_cast<int>(cy * cell_h),
+                       static_cast<int>(cell_w), static_cast<int>(cell_h));
+    const cv::Rect clipped = roi & cv::Rect(0, 0, image.cols, image.rows);
+    if (clipped.width < 8 || clipped.height < 8) continue;
+    std::vector<cv::KeyPoint>& kps = extra[static_cast<size_t>(c)];
+    cv::FAST(image(clipped), kps, options_.min_fast_threshold, true);
+    for (cv::KeyPoint& kp : kps) {
+      kp.pt.x += static_cast<float>(clipped.x);
+      kp.pt.y += static_cast<float>(clipped.y);
+      by_cell[static_cast<size_t>(c)].push_back(&kp);
+    }
+  }
+
+  // Round robin over the cells by rank, so that a shortage of room does not starve
+  // the last cells.
+  for (auto& candidates : by_cell) {
+    std::sort(candidates.begin(), candidates.end(),
+              [](const cv::KeyPoint* a, const cv::KeyPoint* b) { return a->response > b->response; });
+  }
+  std::vector<size_t> next_candidate(static_cast<size_t>(cells), 0);
+  int created = 0;
+  bool progress = true;
+  while (created < room && progress) {
+    progress = false;
+    for (int c = 0; c < cells && created < room; ++c) {
+      const size_t cu = static_cast<size_t>(c);
+      auto& candidates = by_cell[cu];
+      if (count[cu] >= per_cell) continue;
+      // The next candidate of this cell that is still free.
+      while (next_candidate[cu] < candidates.size()) {
+        const cv::KeyPoint* kp = candidates[next_candidate[cu]++];
+        const int x = static_cast<int>(std::lround(kp->pt.x)), y = static_cast<int>(std::lround(kp->pt.y));
+        if (x < 0 || y < 0 || x >= image.cols || y >= image.rows || !mask.at<uint8_t>(y, x)) continue;
+        Track t;
+        t.id = next_id_++;
+        t.uv = Eigen::Vector2f(kp->pt.x, kp->pt.y);
+        t.first_frame = frame_index;
+        t.last_seen_frame = frame_index;
+        t.is_new = true;
+        if (!ExtractPatch(image, t.uv, options_.patch_size, &t.patch)) continue;
+        cv::circle(mask, cv::Point(x, y), radius, cv::Scalar(0), -1);
+        ++count[cu];
+        ++created;
+        progress = true;
+        tracks_.push_back(std::move(t));
+        break;
+      }
+    }
+  }
+  stats_.created = created;
+}
+
+}  // namespace mbslam

@@ -1,0 +1,155 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_TRACKING_FEATURE_TRACKER_H_
+#define MBSLAM_SERVICES_PERCEPTION_TRACKING_FEATURE_TRACKER_H_
+
+// Feature tracking of thesis chapter 2: FAST corners spread over the image by a grid,
+// new features every frame, pyramidal KLT with forward-backward and unicity checks,
+// two-stage matching (wide search first so that movers survive, then guided matching
+// of lost / occluded tracks around positions predicted by the bodies' motion), and
+// occlusion by moving objects' hulls (occluded tracks are kept, not matched, until
+// they reappear).
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include "common/config/options.h"
+#include "services/perception/tracking/track.h"
+
+namespace mbslam {
+
+struct TrackerOptions {
+  int max_features = 1000;             // tracks kept per image (count)
+  int grid_cols = 16;                  // detection grid columns (count)
+  int grid_rows = 12;                  // detection grid rows (count)
+  int fast_threshold = 15;             // FAST intensity threshold (gray levels)
+  int min_fast_threshold = 5;          // retried in cells that find nothing (gray levels)
+  double min_distance_px = 8.0;        // minimum spacing of features (px)
+  int border_px = 8;                   // features closer to the border are dropped (px)
+  int klt_window_px = 15;              // KLT window side (px)
+  int klt_levels = 3;                  // pyramid levels used by KLT (count)
+  int klt_max_iterations = 12;         // KLT iterations per level (count)
+  double klt_epsilon = 0.05;           // KLT convergence (px)
+  double max_forward_backward_px = 0.8;  // forward-backward consistency (px)
+  double unicity_px = 1.2;             // two tracks closer than this keep only the better (px)
+  int max_occluded_frames = 45;        // an occluded track is dropped after this (frames)
+  int patch_size = 11;                 // ZSSD template side for guided matching (px)
+  int guided_radius_px = 8;            // guided search half-window (px)
+  double max_patch_score = 400.0;      // accept a guided match below this ZSSD / pixel (gray^2)
+  double velocity_smoothing = 0.5;     // weight of the newest flow in the velocity estimate
+  double min_patch_ncc = 0.6;          // appearance check of every KLT match against the track's template (NCC)
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION_GT(max_features, 0);
+    MBSLAM_CHECK_OPTION_GT(grid_cols, 0);
+    MBSLAM_CHECK_OPTION_GT(grid_rows, 0);
+    MBSLAM_CHECK_OPTION_GT(fast_threshold, 0);
+    MBSLAM_CHECK_OPTION_GT(min_fast_threshold, 0);
+    MBSLAM_CHECK_OPTION_GE(min_distance_px, 1.0);
+    MBSLAM_CHECK_OPTION_GE(border_px, 0);
+    MBSLAM_CHECK_OPTION_GE(klt_window_px, 5);
+    MBSLAM_CHECK_OPTION_GE(klt_levels, 1);
+    MBSLAM_CHECK_OPTION_GT(klt_max_iterations, 0);
+    MBSLAM_CHECK_OPTION_GT(klt_epsilon, 0.0);
+    MBSLAM_CHECK_OPTION_GT(max_forward_backward_px, 0.0);
+    MBSLAM_CHECK_OPTION_GE(unicity_px, 0.0);
+    MBSLAM_CHECK_OPTION_GE(max_occluded_frames, 0);
+    MBSLAM_CHECK_OPTION_GE(patch_size, 5);
+    MBSLAM_CHECK_OPTION(patch_size % 2 == 1);
+    MBSLAM_CHECK_OPTION_GE(guided_radius_px, 1);
+    MBSLAM_CHECK_OPTION_GT(max_patch_score, 0.0);
+    MBSLAM_CHECK_OPTION(velocity_smoothing > 0.0 && velocity_smoothing <= 1.0);
+    MBSLAM_CHECK_OPTION(min_patch_ncc >= -1.0 && min_patch_ncc < 1.0);
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("max_features", &max_features, "tracks kept per image (count)");
+    v("grid_cols", &grid_cols, "detection grid columns (count)");
+    v("grid_rows", &grid_rows, "detection grid rows (count)");
+    v("fast_threshold", &fast_threshold, "FAST threshold (gray levels)");
+    v("min_fast_threshold", &min_fast_threshold, "FAST threshold retried in empty cells (gray levels)");
+    v("min_distance_px", &min_distance_px, "minimum feature spacing (px)");
+    v("border_px", &border_px, "image border without features (px)");
+    v("klt_window_px", &klt_window_px, "KLT window side (px)");
+    v("klt_levels", &klt_levels, "KLT pyramid levels (count)");
+    v("klt_max_iterations", &klt_max_iterations, "KLT iterations per level (count)");
+    v("klt_epsilon", &klt_epsilon, "KLT convergence (px)");
+    v("max_forward_backward_px", &max_forward_backward_px, "forward-backward check (px)");
+    v("unicity_px", &unicity_px, "tracks closer than this keep only the better one (px)");
+    v("max_occluded_frames", &max_occluded_frames, "occluded tracks dropped after (frames)");
+    v("patch_size", &patch_size, "ZSSD template side, odd (px)");
+    v("guided_radius_px", &guided_radius_px, "guided search half-window (px)");
+    v("max_patch_score", &max_patch_score, "guided match acceptance, ZSSD per pixel (gray^2)");
+    v("velocity_smoothing", &velocity_smoothing, "weight of the newest flow in track velocity (0..1]");
+    v("min_patch_ncc", &min_patch_ncc, "appearance check of KLT matches against the template (NCC)");
+  }
+};
+
+// Feedback from the other modules for one image.
+struct TrackingHints {
+  // Predicted position of a track in the new image (from its body's motion), used as
+  // the KLT starting point and for guided matching.
+  std::unordered_map<int64_t, Eigen::Vector2f> predicted_uv;
+  // Convex hulls (px) of moving objects predicted for the new image, with their body.
+  struct Hull {
+    int body_id = 0;
+    std::vector<Eigen::Vector2f> points;
+  };
+  std::vector<Hull> occluders;
+};
+
+struct TrackerStats {
+  int tracked = 0;        // matched by KLT
+  int lost = 0;           // failed KLT / checks
+  int occluded = 0;       // kept behind hulls
+  int recovered = 0;      // re-found by guided matching
+  int created = 0;        // new features
+  int rejected_unicity = 0;
+};
+
+class FeatureTracker {
+ public:
+  explicit FeatureTracker(const TrackerOptions& options);
+
+  // Tracks into the new image (pyramid level 0 = full resolution), then detects new
+  // features in empty grid cells.
+  void TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t frame_index, const TrackingHints& hints);
+
+  // Stage 2: re-finds tracks that are occluded or were lost in this image near the
+  // given predicted positions (ZSSD on the stored template). Returns the number found.
+  int GuidedMatch(const std::unordered_map<int64_t, Eigen::Vector2f>& predicted_uv);
+
+  std::vector<Track>& tracks() { return tracks_; }
+  const std::vector<Track>& tracks() const { return tracks_; }
+  const TrackerStats& stats() const { return stats_; }
+  const TrackerOptions& options() const { return options_; }
+
+  // Drops every track (tracking reset).
+  void Reset();
+
+ private:
+  void DetectNew(const cv::Mat& image, int64_t frame_index);
+  void EnforceUnicity();
+
+  const TrackerOptions options_;
+  std::vector<cv::Mat> prev_pyramid_;
+  std::vector<Track> tracks_;
+  // Tracks lost in the latest image that guided matching may still recover.
+  std::vector<Track> recently_lost_;
+  int64_t next_id_ = 1;
+  int64_t frame_index_ = -1;
+  TrackerStats stats_;
+};
+
+// True if p lies inside the convex polygon (any orientation).
+bool InsideConvexHull(const std::vector<Eigen::Vector2f>& hull, const Eigen::Vector2f& p);
+
+// Convex hull (counter-clockwise) of a point set.
+std::vector<Eigen::Vector2f> ConvexHull(std::vector<Eigen::Vector2f> points);
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_TRACKING_FEATURE_TRACKER_H_
