@@ -16,6 +16,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "common/config/options.h"
+#include "services/perception/geometry/polygon.h"
 #include "services/perception/tracking/track.h"
 
 namespace mbslam {
@@ -143,12 +144,6 @@ class FeatureTracker {
   int64_t frame_index_ = -1;
   TrackerStats stats_;
 };
-
-// True if p lies inside the convex polygon (any orientation).
-bool InsideConvexHull(const std::vector<Eigen::Vector2f>& hull, const Eigen::Vector2f& p);
-
-// Convex hull (counter-clockwise) of a point set.
-std::vector<Eigen::Vector2f> ConvexHull(std::vector<Eigen::Vector2f> points);
 
 }  // namespace mbslam
 

@@ -1,0 +1,436 @@
+#include "services/perception/segmentation/motion_segmenter.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "services/perception/geometry/polygon.h"
+
+namespace mbslam {
+
+bool MotionSegmenter::TrackState::At(int64_t frame, Eigen::Vector2d* xy_out,
+                                     Eigen::Vector2d* uv_out) const {
+  for (size_t k = frames.size(); k-- > 0;) {
+    if (frames[k] == frame) {
+      if (xy_out) *xy_out = xy[k];
+      if (uv_out) *uv_out = uv[k];
+      return true;
+    }
+    if (frames[k] < frame) break;
+  }
+  return false;
+}
+
+MotionSegmenter::MotionSegmenter(const SegmentationOptions& options) : options_(options) {}
+
+void MotionSegmenter::Reset() {
+  tracks_.clear();
+  objects_.clear();
+  body_of_track_.clear();
+  initialized_ = false;
+  frame_ = -1;
+}
+
+double MotionSegmenter::BayesUpdate(double prior, double likelihood, double parallax_px) const {
+  // Static hypothesis: the fused P(static) of this image; dynamic: its complement
+  // (thesis eq. 3.3 and its dynamic analogue), both with a tail for robustness, and
+  // tempered for the overlapping baselines of consecutive updates.
+  const double l = std::clamp(likelihood, 0.0, 1.0);
+  const double e = options_.likelihood_tail;
+  double log_lr = std::log((l + e) / (1.0 - l + e)) * options_.evidence_weight;
+  if (log_lr > 0.0) log_lr *= std::min(1.0, parallax_px / options_.target_parallax_px);
+  const double odds = prior / (1.0 - prior) * std::exp(log_lr);
+  const double p = odds / (1.0 + odds);
+  return std::clamp(p, 1.0 - options_.p_clamp, options_.p_clamp);
+}
+
+void MotionSegmenter::UpdateHistories(const SegmenterInput& in) {
+  const double prior_r2 = std::pow(options_.neighbour_prior_radius * in.width, 2);
+  std::vector<const TrackState*> established;
+  established.reserve(in.observations.size());
+  for (const TrackObservation& o : in.observations) {
+    auto it = tracks_.find(o.id);
+    if (it != tracks_.end() && it->second.frames.size() >= 2) established.push_back(&it->second);
+  }
+  for (const TrackObservation& o : in.observations) {
+    auto [it, inserted] = tracks_.try_emplace(o.id);
+    TrackState& t = it->second;
+    if (inserted) {
+      t.id = o.id;
+      // Prior from established neighbours: features appear on movers too.
+      double sum = 0.0;
+      int count = 0;
+      for (const TrackState* n : established) {
+        if ((n->uv.back() - o.uv).squaredNorm() <= prior_r2) {
+          sum += n->p_static;
+          ++count;
+        }
+      }
+      if (count >= 3) t.p_static = std::clamp(0.5 + 0.8 * (sum / count - 0.5), 0.05, 0.95);
+      t.moving = t.p_static < options_.static_leave;
+    }
+    t.frames.push_back(in.frame_index);
+    t.xy.push_back(o.xy);
+    t.uv.push_back(o.uv);
+    t.last_frame = in.frame_index;
+    while (static_cast<int>(t.frames.size()) > options_.history_frames) {
+      t.frames.erase(t.frames.begin());
+      t.xy.erase(t.xy.begin());
+      t.uv.erase(t.uv.begin());
+    }
+  }
+  for (auto it = tracks_.begin(); it != tracks_.end();) {
+    if (in.frame_index - it->second.last_frame > options_.history_frames) it = tracks_.erase(it);
+    else ++it;
+  }
+}
+
+std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput& in, int64_t ref) {
+  if (in.world_motion) {
+    if (auto m = in.world_motion(ref, in.frame_index)) return m;
+  }
+  std::vector<Eigen::Vector2d> xr, xn, xr_all, xn_all;
+  for (const TrackObservation& o : in.observations) {
+    const TrackState& t = tracks_.at(o.id);
+    Eigen::Vector2d x;
+    if (!t.At(ref, &x)) continue;
+    xr_all.push_back(x);
+    xn_all.push_back(o.xy);
+    if (!t.moving && t.object == 0) {
+      xr.push_back(x);
+      xn.push_back(o.xy);
+    }
+  }
+  // Until the static world is established, the dominant motion of all tracks is it.
+  if (!initialized_ || static_cast<int>(xr.size()) < options_.world_min_tracks) {
+    xr = std::move(xr_all);
+    xn = std::move(xn_all);
+  }
+  RelativeMotion motion;
+  std::vector<uint8_t> inliers;
+  if (!EstimateRelativeMotion(xr, xn, in.focal_px, options_.two_view, &motion, &inliers).ok()) {
+    return std::nullopt;
+  }
+  return motion;
+}
+
+void MotionSegmenter::UpdateStaticProbabilities(const SegmenterInput& in, int64_t ref,
+                                                const RelativeMotion& motion) {
+  const std::vector<MotionSample> samples = MotionSigmaPoints(motion);
+  for (const TrackObservation& o : in.observations) {
+    TrackState& t = tracks_.at(o.id);
+    Eigen::Vector2d x_r;
+    if (!t.At(ref, &x_r)) continue;
+    const DepthBound depth = in.depth_bound ? in.depth_bound(o.id, x_r, ref) : DepthBound();
+    const StaticLikelihood lik =
+        ComputeStaticLikelihood(x_r, o.xy, samples, motion.translation_known, motion.scale_known,
+                                depth, in.focal_px, options_.likelihood);
+    t.p_static = BayesUpdate(t.p_static, lik.p_static, lik.parallax_px);
+    t.epipolar_px = lik.epipolar_px;
+    t.p_fvb = lik.p_fvb;
+    if (t.moving && t.p_static >= options_.static_enter) t.moving = false;
+    else if (!t.moving && t.p_static < options_.static_leave) t.moving = true;
+  }
+}
+
+void MotionSegmenter::UpdateObjectModels(const SegmenterInput& in, int64_t ref) {
+  for (auto& [id, obj] : objects_) {
+    obj.motion.reset();
+    if (!obj.confirmed) continue;
+    std::vector<Eigen::Vector2d> xr, xn;
+    std::vector<int64_t> ids;
+    for (const TrackObservation& o : in.observations) {
+      const TrackState& t = tracks_.at(o.id);
+      Eigen::Vector2d x;
+      if (t.object != id || !t.moving || !t.At(ref, &x)) continue;
+      xr.push_back(x);
+      xn.push_back(o.xy);
+      ids.push_back(o.id);
+    }
+    if (static_cast<int>(xr.size()) < options_.min_model_tracks) continue;
+    RelativeMotion m;
+    std::vector<uint8_t> inliers;
+    if (!EstimateRelativeMotion(xr, xn, in.focal_px, options_.two_view, &m, &inliers).ok()) continue;
+    obj.motion = m;
+  }
+  // Membership by the likelihood w.r.t. each modelled object: members that do not
+  // fit leave, moving unassigned tracks that fit join.
+  for (auto& [id, obj] : objects_) {
+    if (!obj.motion) continue;
+    const std::vector<MotionSample> samples = MotionSigmaPoints(*obj.motion);
+    for (const TrackObservation& o : in.observations) {
+      TrackState& t = tracks_.at(o.id);
+      if (!t.moving || (t.object != 0 && t.object != id)) continue;
+      Eigen::Vector2d x_r;
+      if (!t.At(ref, &x_r)) continue;
+      const StaticLikelihood lik = ComputeStaticLikelihood(
+          x_r, o.xy, samples, obj.motion->translation_known, false, DepthBound(), in.focal_px,
+          options_.likelihood);
+      auto [pit, inserted] = t.p_object.try_emplace(id, 0.5);
+      pit->second = BayesUpdate(pit->second, lik.p_static, lik.parallax_px);
+      if (t.object == id && pit->second < options_.static_leave) t.object = 0;
+      else if (t.object == 0 && pit->second >= options_.static_enter) t.object = id;
+    }
+  }
+}
+
+namespace {
+
+struct UnionFind {
+  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  size_t Find(size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void Union(size_t a, size_t b) {
+    a = Find(a);
+    b = Find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+  std::vector<size_t> parent;
+};
+
+}  // namespace
+
+void MotionSegmenter::ClusterUnexplained(const SegmenterInput& in, int64_t ref) {
+  // Candidates: moving tracks with a flow over the lag (or at least one image).
+  struct Candidate {
+    TrackState* t;
+    Eigen::Vector2d uv;
+    Eigen::Vector2d flow;  // px per image
+  };
+  std::vector<Candidate> cands;
+  for (const TrackObservation& o : in.observations) {
+    TrackState& t = tracks_.at(o.id);
+    if (!t.moving) {
+      t.object = 0;
+      continue;
+    }
+    Eigen::Vector2d uv_ref;
+    int64_t span = in.frame_index - ref;
+    if (!t.At(ref, nullptr, &uv_ref)) {
+      if (t.frames.size() < 2) continue;
+      uv_ref = t.uv[t.uv.size() - 2];
+      span = in.frame_index - t.frames[t.frames.size() - 2];
+    }
+    cands.push_back(Candidate{&t, o.uv, (o.uv - uv_ref) / static_cast<double>(std::max<int64_t>(1, span))});
+  }
+  const size_t n = cands.size();
+  const double radius2 = std::pow(options_.cluster_radius * in.width, 2);
+  const double lag = static_cast<double>(options_.lag_frames);
+  UnionFind uf(n);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; ++j) {
+      const Candidate& a = cands[i];
+      const Candidate& b = cands[j];
+      const double d2 = (a.uv - b.uv).squaredNorm();
+      if (d2 > radius2) continue;
+      // Motion coherence: similar flow over the lag...
+      const double df = (a.flow - b.flow).norm() * lag;
+      const double fmax = std::max(a.flow.norm(), b.flow.norm()) * lag;
+      if (df > std::max(options_.coherence_abs_px, options_.coherence_rel * fmax)) continue;
+      // ...and a pair distance that changes slowly over the shared history.
+      double sum = 0.0, sum2 = 0.0;
+      int count = 0;
+      for (size_t k = 0; k < a.t->frames.size(); ++k) {
+        Eigen::Vector2d uv_b;
+        if (!b.t->At(a.t->frames[k], nullptr, &uv_b)) continue;
+        const double d = (a.t->uv[k] - uv_b).norm();
+        sum += d;
+        sum2 += d * d;
+        ++count;
+      }
+      if (count >= 3) {
+        const double mean = sum / count;
+        const double var = std::max(0.0, sum2 / count - mean * mean);
+        if (std::sqrt(var) > options_.distance_std_px + options_.distance_std_rel * mean) continue;
+      }
+      uf.Union(i, j);
+    }
+  }
+  std::map<size_t, std::vector<size_t>> components;
+  for (size_t i = 0; i < n; ++i) components[uf.Find(i)].push_back(i);
+
+  // Largest components first, so that when an object splits the bigger part keeps the id.
+  std::vector<std::vector<size_t>> comps;
+  for (auto& [root, members] : components) comps.push_back(std::move(members));
+  std::sort(comps.begin(), comps.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
+
+  std::map<int, bool> claimed;
+  for (const auto& members : comps) {
+    if (static_cast<int>(members.size()) < options_.min_object_tracks) {
+      // Too small for an object: members of a confirmed object keep it (the object may
+      // be partly occluded); others stay unassigned.
+      for (size_t m : members) {
+        TrackState* t = cands[m].t;
+        auto it = objects_.find(t->object);
+        if (it == objects_.end() || !it->second.confirmed) t->object = 0;
+      }
+      continue;
+    }
+    // Identity by majority of previous memberships; merges take the oldest id.
+    std::map<int, int> votes;
+    for (size_t m : members) {
+      if (cands[m].t->object > 0 && objects_.count(cands[m].t->object)) ++votes[cands[m].t->object];
+    }
+    int id = 0;
+    int best = 0;
+    for (const auto& [oid, v] : votes) {
+      if (claimed.count(oid)) continue;
+      if (v > best || (v == best && oid < id)) {
+        best = v;
+        id = oid;
+      }
+    }
+    if (id == 0 || best * 4 < static_cast<int>(members.size())) {
+      id = next_object_id_++;
+      ObjectState obj;
+      obj.id = id;
+      obj.first_frame = in.frame_index;
+      objects_[id] = obj;
+    }
+    claimed[id] = true;
+    ObjectState& obj = objects_[id];
+    obj.last_frame = in.frame_index;
+    ++obj.confirmations;
+    if (obj.confirmations >= options_.confirm_frames) obj.confirmed = true;
+    for (size_t m : members) cands[m].t->object = id;
+    // Objects fully absorbed by this component are merged into it.
+    for (const auto& [oid, v] : votes) {
+      if (oid != id && v * 2 >= static_cast<int>(members.size()) / 4 && !claimed.count(oid)) {
+        if (objects_[oid].confirmed && objects_[oid].first_frame < obj.first_frame) {
+          obj.first_frame = objects_[oid].first_frame;
+        }
+      }
+    }
+  }
+  // Objects that lost all members this image age out.
+  for (auto it = objects_.begin(); it != objects_.end();) {
+    const ObjectState& obj = it->second;
+    const bool seen = claimed.count(obj.id) > 0;
+    if (!seen && (!obj.confirmed || in.frame_index - obj.last_frame > options_.object_timeout_frames)) {
+      for (auto& [tid, t] : tracks_) {
+        if (t.object == obj.id) t.object = 0;
+      }
+      it = objects_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+int64_t MotionSegmenter::ChooseReference(const SegmenterInput& in) const {
+  // The nearest image at least lag_frames back in which the static tracks had moved
+  // target_parallax_px (median image displacement), else the oldest one kept: a longer
+  // baseline makes both constraints, and the flow bound above all, more decisive.
+  int64_t oldest = in.frame_index;
+  for (const TrackObservation& o : in.observations) {
+    oldest = std::min(oldest, tracks_.at(o.id).frames.front());
+  }
+  const int64_t earliest = std::max(oldest, in.frame_index - options_.history_frames + 1);
+  int64_t ref = std::max(earliest, in.frame_index - options_.lag_frames);
+  for (; ref > earliest; --ref) {
+    std::vector<double> disp;
+    for (const TrackObservation& o : in.observations) {
+      const TrackState& t = tracks_.at(o.id);
+      Eigen::Vector2d uv;
+      if (t.moving || !t.At(ref, nullptr, &uv)) continue;
+      disp.push_back((o.uv - uv).norm());
+    }
+    if (disp.size() < 8) break;
+    std::nth_element(disp.begin(), disp.begin() + disp.size() / 2, disp.end());
+    if (disp[disp.size() / 2] >= options_.target_parallax_px) break;
+  }
+  return ref;
+}
+
+SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
+  frame_ = in.frame_index;
+  UpdateHistories(in);
+  SegmentationResult result;
+  result.frame_index = in.frame_index;
+
+  // Reference images: an adaptive lag for established tracks, the previous image for
+  // young ones.
+  const int64_t ref = ChooseReference(in);
+  if (ref < in.frame_index) {
+    std::optional<RelativeMotion> motion = WorldMotion(in, ref);
+    if (motion) {
+      initialized_ = true;
+      UpdateStaticProbabilities(in, ref, *motion);
+      result.world_motion = motion;
+      result.world_ref_frame = ref;
+      if (motion->translation_known) {
+        const Eigen::Vector3d e = in.K * motion->cam_n_from_cam_r.translation;
+        result.epipole = e;
+      }
+    }
+    // Tracks too young for `ref` use the previous image.
+    const int64_t prev = in.frame_index - 1;
+    if (ref != prev) {
+      bool any_young = false;
+      for (const TrackObservation& o : in.observations) {
+        const TrackState& t = tracks_.at(o.id);
+        if (!t.At(ref, nullptr) && t.At(prev, nullptr)) {
+          any_young = true;
+          break;
+        }
+      }
+      if (any_young) {
+        if (std::optional<RelativeMotion> m1 = WorldMotion(in, prev)) {
+          // Only the young tracks: hide the others' reference by evaluating on a filtered set.
+          SegmenterInput young = in;
+          young.observations.clear();
+          for (const TrackObservation& o : in.observations) {
+            const TrackState& t = tracks_.at(o.id);
+            if (!t.At(ref, nullptr) && t.At(prev, nullptr)) young.observations.push_back(o);
+          }
+          UpdateStaticProbabilities(young, prev, *m1);
+        }
+      }
+    }
+    UpdateObjectModels(in, ref);
+    ClusterUnexplained(in, ref);
+  }
+  result.initialized = initialized_;
+
+  body_of_track_.clear();
+  std::map<int, SegmentedObject> out_objects;
+  for (const TrackObservation& o : in.observations) {
+    const TrackState& t = tracks_.at(o.id);
+    TrackLabel label;
+    label.id = o.id;
+    label.p_static = t.p_static;
+    label.epipolar_px = t.epipolar_px;
+    label.p_fvb = t.p_fvb;
+    label.evaluated = t.frames.size() >= 2;
+    if (!t.moving) {
+      label.body_id = label.evaluated ? 0 : -1;
+    } else {
+      auto it = objects_.find(t.object);
+      label.body_id = (it != objects_.end() && it->second.confirmed) ? t.object : -1;
+    }
+    if (label.body_id > 0) {
+      SegmentedObject& so = out_objects[label.body_id];
+      so.track_ids.push_back(o.id);
+      if (t.uv.size() >= 2) so.mean_flow_px += t.uv.back() - t.uv[t.uv.size() - 2];
+    }
+    body_of_track_[o.id] = label.body_id;
+    result.labels.push_back(label);
+  }
+  for (auto& [id, so] : out_objects) {
+    const ObjectState& obj = objects_.at(id);
+    so.id = id;
+    so.first_frame = obj.first_frame;
+    so.last_frame = obj.last_frame;
+    so.has_motion_model = obj.motion.has_value();
+    so.mean_flow_px /= static_cast<double>(so.track_ids.size());
+    std::vector<Eigen::Vector2f> pts;
+    for (int64_t tid : so.track_ids) pts.push_back(tracks_.at(tid).uv.back().cast<float>());
+    for (const Eigen::Vector2f& p : ConvexHull(pts)) so.hull.push_back(p.cast<double>());
+    result.objects.push_back(std::move(so));
+  }
+  return result;
+}
+
+}  // namespace mbslam

@@ -1,0 +1,203 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_MOTION_SEGMENTER_H_
+#define MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_MOTION_SEGMENTER_H_
+
+// Incremental multibody motion segmentation (thesis ch. 3). Every image:
+//  1. the static world's motion between a reference image and this one comes from
+//     SLAM or odometry when available, else from a robust two-view estimate on the
+//     tracks currently believed static (the dominant motion at start-up);
+//  2. each track's P(static) is updated by recursive Bayes with the fused
+//     epipolar-envelope / Flow-Vector-Bound likelihood;
+//  3. objects with enough tracks get their own motion model, and tracks are
+//     (re)assigned by the same likelihood w.r.t. that model;
+//  4. unexplained tracks are clustered by spatial proximity and motion coherence into
+//     new objects; objects appear, split, merge and leave.
+// Works on tracks alone (no images): the tracks-only entry point for Hopkins-style data.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/config/options.h"
+#include "services/perception/segmentation/relative_motion.h"
+#include "services/perception/segmentation/static_likelihood.h"
+
+namespace mbslam {
+
+struct SegmentationOptions {
+  StaticLikelihoodOptions likelihood;
+  TwoViewOptions two_view;
+  int lag_frames = 3;               // reference image at least this many images back (frames)
+  int history_frames = 16;          // per-track history kept; the reference is at most this far back (frames)
+  double target_parallax_px = 12.0; // the reference goes back until static tracks moved this much (px)
+  double evidence_weight = 0.5;     // exponent on each image's likelihood ratio (overlapping windows)
+  double likelihood_tail = 0.05;    // added to both hypotheses' likelihoods: one bad match is not proof
+  double p_clamp = 0.98;            // posterior clamp, lets a label switch within a few images
+  double static_enter = 0.6;        // P(static) to become static again
+  double static_leave = 0.4;        // P(static) below which a track is moving
+  double neighbour_prior_radius = 0.06;  // new tracks take their prior from neighbours within this (fraction of width)
+  int min_object_tracks = 6;        // tracks needed for an object (count)
+  int confirm_frames = 2;           // a cluster must persist this long to become an object (frames)
+  int object_timeout_frames = 15;   // an object unseen this long is removed (frames)
+  double cluster_radius = 0.12;     // spatial proximity for clustering (fraction of image width)
+  double coherence_abs_px = 2.0;    // flow difference always accepted as coherent (px over the lag)
+  double coherence_rel = 0.35;      // flow difference accepted relative to the flow (fraction)
+  double distance_std_px = 1.5;     // allowed std of a pair's distance over the history (px)
+  double distance_std_rel = 0.05;   // ... plus this fraction of the distance
+  int min_model_tracks = 10;        // an object gets its own motion model above this (count)
+  int world_min_tracks = 15;        // static tracks needed to estimate the world motion (count)
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION_SECTION(likelihood);
+    MBSLAM_CHECK_OPTION_GE(lag_frames, 1);
+    MBSLAM_CHECK_OPTION_GT(history_frames, lag_frames);
+    MBSLAM_CHECK_OPTION_GT(target_parallax_px, 0.0);
+    MBSLAM_CHECK_OPTION(evidence_weight > 0.0 && evidence_weight <= 1.0);
+    MBSLAM_CHECK_OPTION(likelihood_tail > 0.0 && likelihood_tail < 1.0);
+    MBSLAM_CHECK_OPTION(p_clamp > 0.5 && p_clamp < 1.0);
+    MBSLAM_CHECK_OPTION(static_leave <= static_enter);
+    MBSLAM_CHECK_OPTION_GE(min_object_tracks, 2);
+    MBSLAM_CHECK_OPTION_GE(confirm_frames, 1);
+    MBSLAM_CHECK_OPTION_GE(object_timeout_frames, 1);
+    MBSLAM_CHECK_OPTION_GT(cluster_radius, 0.0);
+    MBSLAM_CHECK_OPTION_GE(min_model_tracks, 8);
+    MBSLAM_CHECK_OPTION_GE(world_min_tracks, 8);
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("likelihood", &likelihood, "epipolar + Flow Vector Bound likelihood");
+    v("two_view", &two_view, "robust two-view motion estimate");
+    v("lag_frames", &lag_frames, "reference image this many images back (frames)");
+    v("history_frames", &history_frames, "per-track history; longest reference lag (frames)");
+    v("target_parallax_px", &target_parallax_px, "reference goes back until static tracks moved this much (px)");
+    v("evidence_weight", &evidence_weight, "exponent on each image's likelihood ratio");
+    v("likelihood_tail", &likelihood_tail, "added to both hypotheses' likelihoods (robustness)");
+    v("p_clamp", &p_clamp, "posterior clamp");
+    v("static_enter", &static_enter, "P(static) to become static");
+    v("static_leave", &static_leave, "P(static) below which a track is moving");
+    v("neighbour_prior_radius", &neighbour_prior_radius, "prior radius for new tracks (fraction of width)");
+    v("min_object_tracks", &min_object_tracks, "tracks needed for an object (count)");
+    v("confirm_frames", &confirm_frames, "frames a cluster must persist (frames)");
+    v("object_timeout_frames", &object_timeout_frames, "unseen objects removed after (frames)");
+    v("cluster_radius", &cluster_radius, "clustering proximity (fraction of image width)");
+    v("coherence_abs_px", &coherence_abs_px, "coherent flow difference (px over the lag)");
+    v("coherence_rel", &coherence_rel, "coherent flow difference relative to the flow");
+    v("distance_std_px", &distance_std_px, "allowed std of pair distances (px)");
+    v("distance_std_rel", &distance_std_rel, "allowed std of pair distances (fraction)");
+    v("min_model_tracks", &min_model_tracks, "tracks for an object's own motion model (count)");
+    v("world_min_tracks", &world_min_tracks, "static tracks to estimate the world motion (count)");
+  }
+};
+
+// One track observed in the current image.
+struct TrackObservation {
+  int64_t id = 0;
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // distorted pixel position
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // normalised undistorted coordinates
+};
+
+struct SegmenterInput {
+  int64_t frame_index = 0;
+  int width = 0;          // image width (px)
+  int height = 0;         // image height (px)
+  double focal_px = 1.0;  // mean focal length (px)
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();  // intrinsics (for the epipole in px)
+  std::vector<TrackObservation> observations;
+  // Motion of the camera w.r.t. the static world between two frame indices (SLAM or
+  // odometry); nullopt = estimate it from the tracks.
+  std::function<std::optional<RelativeMotion>(int64_t ref_frame, int64_t cur_frame)> world_motion;
+  // Depth bounds of a track in the reference camera (map); nullptr = [0, inf).
+  std::function<DepthBound(int64_t track_id, const Eigen::Vector2d& xy_ref, int64_t ref_frame)> depth_bound;
+};
+
+struct TrackLabel {
+  int64_t id = 0;
+  int body_id = -1;          // 0 static world, > 0 object, -1 unassigned (moving, no object yet / outlier)
+  double p_static = 0.5;     // posterior P(static w.r.t. the world)
+  double epipolar_px = NAN;  // last distance to the world's mean epipolar line (px)
+  double p_fvb = NAN;        // last P_FVB
+  bool evaluated = false;    // has a likelihood from this image
+};
+
+struct SegmentedObject {
+  int id = 0;
+  int64_t first_frame = 0;
+  int64_t last_frame = 0;
+  std::vector<int64_t> track_ids;           // members observed in this image
+  std::vector<Eigen::Vector2d> hull;        // convex hull (px)
+  Eigen::Vector2d mean_flow_px = Eigen::Vector2d::Zero();  // mean flow per image (px)
+  bool has_motion_model = false;
+};
+
+struct SegmentationResult {
+  int64_t frame_index = 0;
+  std::vector<TrackLabel> labels;   // one per observation, same order
+  std::vector<SegmentedObject> objects;
+  std::optional<RelativeMotion> world_motion;  // used for this image (ref -> current)
+  int64_t world_ref_frame = -1;
+  Eigen::Vector3d epipole = Eigen::Vector3d::Zero();  // homogeneous, px
+  bool initialized = false;          // the static world has been identified
+};
+
+class MotionSegmenter {
+ public:
+  explicit MotionSegmenter(const SegmentationOptions& options);
+
+  SegmentationResult Update(const SegmenterInput& input);
+  void Reset();
+
+  // Labels by id after the last Update (for feeding back to the tracker).
+  const std::unordered_map<int64_t, int>& body_of_track() const { return body_of_track_; }
+
+ private:
+  struct TrackState {
+    int64_t id = 0;
+    std::vector<int64_t> frames;          // observation frames, oldest first
+    std::vector<Eigen::Vector2d> xy;      // normalised
+    std::vector<Eigen::Vector2d> uv;      // px
+    double p_static = 0.5;
+    bool moving = false;                  // hysteresis state
+    int object = 0;                       // > 0: member of that object (or candidate)
+    int64_t last_frame = 0;
+    double epipolar_px = NAN;
+    double p_fvb = NAN;
+    std::map<int, double> p_object;       // P(static w.r.t. object) for objects with a model
+
+    bool At(int64_t frame, Eigen::Vector2d* xy_out, Eigen::Vector2d* uv_out = nullptr) const;
+  };
+  struct ObjectState {
+    int id = 0;
+    int64_t first_frame = 0;
+    int64_t last_frame = 0;
+    int confirmations = 0;
+    bool confirmed = false;
+    std::optional<RelativeMotion> motion;
+  };
+
+  void UpdateHistories(const SegmenterInput& input);
+  std::optional<RelativeMotion> WorldMotion(const SegmenterInput& input, int64_t ref);
+  void UpdateStaticProbabilities(const SegmenterInput& input, int64_t ref, const RelativeMotion& motion);
+  void UpdateObjectModels(const SegmenterInput& input, int64_t ref);
+  void ClusterUnexplained(const SegmenterInput& input, int64_t ref);
+  // `parallax_px`: how much the pair could tell; static evidence from pairs with little
+  // parallax is discounted (they cannot reveal a degenerate mover yet).
+  double BayesUpdate(double prior, double likelihood, double parallax_px) const;
+  int64_t ChooseReference(const SegmenterInput& input) const;
+
+  const SegmentationOptions options_;
+  std::unordered_map<int64_t, TrackState> tracks_;
+  std::map<int, ObjectState> objects_;
+  std::unordered_map<int64_t, int> body_of_track_;
+  int next_object_id_ = 1;
+  int64_t frame_ = -1;
+  bool initialized_ = false;
+};
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_MOTION_SEGMENTER_H_

@@ -1,0 +1,248 @@
+#include "services/perception/segmentation/relative_motion.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+namespace mbslam {
+
+double EpipolarDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& x_r,
+                        const Eigen::Vector2d& x_n) {
+  const Eigen::Vector3d l = E * x_r.homogeneous();
+  const double norm = std::hypot(l.x(), l.y());
+  if (norm < 1e-15) return 0.0;
+  return x_n.homogeneous().dot(l) / norm;
+}
+
+std::vector<MotionSample> MotionSigmaPoints(const RelativeMotion& motion, double kappa) {
+  auto make = [&](const Rigid3d& T, double w) {
+    MotionSample s;
+    s.R = T.RotationMatrix();
+    s.t = T.translation;
+    s.E = Hat(s.t) * s.R;
+    s.weight = w;
+    return s;
+  };
+  std::vector<MotionSample> samples;
+  Eigen::SelfAdjointEigenSolver<Matrix6d> eig(motion.covariance);
+  std::vector<int> dirs;
+  const double max_ev = eig.eigenvalues().maxCoeff();
+  for (int i = 0; i < 6; ++i) {
+    if (max_ev > 0.0 && eig.eigenvalues()[i] > 1e-9 * max_ev && eig.eigenvalues()[i] > 1e-16) {
+      dirs.push_back(i);
+    }
+  }
+  const double n = static_cast<double>(dirs.size());
+  const double w0 = kappa / (n + kappa);
+  const double wi = dirs.empty() ? 0.0 : 1.0 / (2.0 * (n + kappa));
+  samples.push_back(make(motion.cam_n_from_cam_r, dirs.empty() ? 1.0 : w0));
+  for (int i : dirs) {
+    const Vector6d step = std::sqrt((n + kappa) * eig.eigenvalues()[i]) * eig.eigenvectors().col(i);
+    for (double sign : {1.0, -1.0}) {
+      samples.push_back(make(Rigid3d::Exp(sign * step) * motion.cam_n_from_cam_r, wi));
+    }
+  }
+  return samples;
+}
+
+namespace {
+
+// Epipolar residuals of the inliers w.r.t. a left perturbation of the motion, and the
+// resulting covariance sigma^2 (J^T J)^-1 on the observable directions.
+Matrix6d EpipolarCovariance(const Rigid3d& T, const std::vector<Eigen::Vector2d>& x_r,
+                            const std::vector<Eigen::Vector2d>& x_n,
+                            const std::vector<uint8_t>& inliers, double sigma) {
+  Matrix6d info = Matrix6d::Zero();
+  constexpr double h = 1e-6;
+  for (size_t i = 0; i < x_r.size(); ++i) {
+    if (!inliers[i]) continue;
+    Eigen::Matrix<double, 1, 6> J;
+    for (int k = 0; k < 6; ++k) {
+      Vector6d d = Vector6d::Zero();
+      d[k] = h;
+      const Rigid3d Tp = Rigid3d::Exp(d) * T;
+      const Rigid3d Tm = Rigid3d::Exp(-d) * T;
+      const double rp = EpipolarDistance(Hat(Tp.translation) * Tp.RotationMatrix(), x_r[i], x_n[i]);
+      const double rm = EpipolarDistance(Hat(Tm.translation) * Tm.RotationMatrix(), x_r[i], x_n[i]);
+      J[k] = (rp - rm) / (2.0 * h);
+    }
+    info += J.transpose() * J;
+  }
+  Eigen::SelfAdjointEigenSolver<Matrix6d> eig(info);
+  Matrix6d cov = Matrix6d::Zero();
+  const double max_ev = eig.eigenvalues().maxCoeff();
+  for (int i = 0; i < 6; ++i) {
+    const double ev = eig.eigenvalues()[i];
+    if (ev > 1e-8 * max_ev && ev > 0.0) {
+      cov += (sigma * sigma / ev) * eig.eigenvectors().col(i) * eig.eigenvectors().col(i).transpose();
+    }
+  }
+  return cov;
+}
+
+// Gauss-Newton / Levenberg-Marquardt on the inliers' epipolar distances over a left
+// perturbation of the motion; the translation is renormalised (5 effective dof).
+Rigid3d RefineMotion(const Rigid3d& initial, const std::vector<Eigen::Vector2d>& x_r,
+                     const std::vector<Eigen::Vector2d>& x_n, const std::vector<uint8_t>& inliers,
+                     double huber) {
+  Rigid3d T = initial;
+  auto cost_of = [&](const Rigid3d& M) {
+    const Eigen::Matrix3d E = Hat(M.translation) * M.RotationMatrix();
+    double c = 0.0;
+    for (size_t i = 0; i < x_r.size(); ++i) {
+      if (!inliers[i]) continue;
+      const double r = std::abs(EpipolarDistance(E, x_r[i], x_n[i]));
+      c += r <= huber ? r * r : 2.0 * huber * r - huber * huber;
+    }
+    return c;
+  };
+  double cost = cost_of(T);
+  double lambda = 1e-3;
+  constexpr double h = 1e-7;
+  for (int iter = 0; iter < 15; ++iter) {
+    Matrix6d JtJ = Matrix6d::Zero();
+    Vector6d Jtr = Vector6d::Zero();
+    const Eigen::Matrix3d E0 = Hat(T.translation) * T.RotationMatrix();
+    Rigid3d Tp[6];
+    Eigen::Matrix3d Ep[6];
+    for (int k = 0; k < 6; ++k) {
+      Vector6d d = Vector6d::Zero();
+      d[k] = h;
+      Tp[k] = Rigid3d::Exp(d) * T;
+      Ep[k] = Hat(Tp[k].translation) * Tp[k].RotationMatrix();
+    }
+    for (size_t i = 0; i < x_r.size(); ++i) {
+      if (!inliers[i]) continue;
+      const double r = EpipolarDistance(E0, x_r[i], x_n[i]);
+      Eigen::Matrix<double, 1, 6> J;
+      for (int k = 0; k < 6; ++k) J[k] = (EpipolarDistance(Ep[k], x_r[i], x_n[i]) - r) / h;
+      const double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
+      JtJ += w * J.transpose() * J;
+      Jtr += w * J.transpose() * r;
+    }
+    Matrix6d A = JtJ;
+    A.diagonal() += lambda * (JtJ.diagonal().array() + 1e-12).matrix();
+    const Vector6d delta = A.ldlt().solve(-Jtr);
+    if (!delta.allFinite()) break;
+    Rigid3d candidate = Rigid3d::Exp(delta) * T;
+    candidate.translation.normalize();
+    const double new_cost = cost_of(candidate);
+    if (new_cost < cost) {
+      T = candidate;
+      const double gain = cost - new_cost;
+      cost = new_cost;
+      lambda = std::max(1e-7, lambda * 0.3);
+      if (gain < 1e-10 * cost) break;
+    } else {
+      lambda *= 10.0;
+      if (lambda > 1e6) break;
+    }
+  }
+  return T;
+}
+
+}  // namespace
+
+Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
+                              const std::vector<Eigen::Vector2d>& x_n, double focal_px,
+                              const TwoViewOptions& options, RelativeMotion* motion,
+                              std::vector<uint8_t>* inliers) {
+  const size_t n = x_r.size();
+  if (n < static_cast<size_t>(options.min_points) || x_n.size() != n) {
+    return Status::Error("too few correspondences (" + std::to_string(n) + ")");
+  }
+  const double thresh = options.ransac_threshold_px / focal_px;
+  std::vector<cv::Point2d> pr(n), pn(n);
+  for (size_t i = 0; i < n; ++i) {
+    pr[i] = cv::Point2d(x_r[i].x(), x_r[i].y());
+    pn[i] = cv::Point2d(x_n[i].x(), x_n[i].y());
+  }
+  // Rotation-only model first: if it explains the flow, translation is unobservable.
+  // Fit R by the orthogonal Procrustes solution on the bearing vectors, with a robust
+  // re-weighting pass.
+  std::vector<Eigen::Vector3d> br(n), bn(n);
+  for (size_t i = 0; i < n; ++i) {
+    br[i] = x_r[i].homogeneous().normalized();
+    bn[i] = x_n[i].homogeneous().normalized();
+  }
+  Eigen::Matrix3d R_rot = Eigen::Matrix3d::Identity();
+  std::vector<double> residual(n, 0.0);
+  std::vector<uint8_t> rot_inlier(n, 1);
+  for (int pass = 0; pass < 3; ++pass) {
+    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      if (rot_inlier[i]) H += bn[i] * br[i].transpose();
+    }
+    Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+    D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() > 0 ? 1.0 : -1.0;
+    R_rot = svd.matrixU() * D * svd.matrixV().transpose();
+    std::vector<double> sorted;
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d p = R_rot * x_r[i].homogeneous();
+      residual[i] = (p.hnormalized() - x_n[i]).norm() * focal_px;
+      sorted.push_back(residual[i]);
+    }
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double med = sorted[sorted.size() / 2];
+    for (size_t i = 0; i < n; ++i) rot_inlier[i] = residual[i] <= std::max(3.0 * med, options.ransac_threshold_px);
+  }
+  std::vector<double> inl_res;
+  for (size_t i = 0; i < n; ++i) {
+    if (rot_inlier[i]) inl_res.push_back(residual[i]);
+  }
+  std::nth_element(inl_res.begin(), inl_res.begin() + inl_res.size() / 2, inl_res.end());
+  const double median_parallax = inl_res.empty() ? 0.0 : inl_res[inl_res.size() / 2];
+  if (median_parallax < options.min_parallax_px) {
+    motion->cam_n_from_cam_r = Rigid3d(Eigen::Matrix3d(R_rot), Eigen::Vector3d::Zero());
+    motion->translation_known = false;
+    motion->scale_known = false;
+    motion->source = RelativeMotion::Source::kTwoView;
+    *inliers = rot_inlier;
+    // Each inlier constrains the rotation through its 2D residual, about one radian
+    // per focal length: var(r) ~ sigma^2 / (N f^2) per axis.
+    int count = 0;
+    for (uint8_t v : rot_inlier) count += v;
+    const double var = std::pow(options.sigma_px / focal_px, 2) / std::max(1, count);
+    motion->covariance = Matrix6d::Zero();
+    motion->covariance.bottomRightCorner<3, 3>() = var * Eigen::Matrix3d::Identity();
+    return Status::Ok();
+  }
+
+  cv::Mat mask;
+  cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC,
+                                   options.ransac_confidence, thresh, mask);
+  if (E.empty() || E.rows != 3) return Status::Error("essential matrix RANSAC failed");
+  cv::Mat R, t;
+  const int good = cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask);
+  if (good < options.min_points) return Status::Error("pose recovery found too few points in front");
+  Eigen::Matrix3d Re;
+  Eigen::Vector3d te;
+  cv::cv2eigen(R, Re);
+  cv::cv2eigen(t, te);
+  Rigid3d T(Re, te.normalized());
+  inliers->assign(n, 0);
+  for (int round = 0; round < 2; ++round) {
+    const Eigen::Matrix3d Em = Hat(T.translation) * T.RotationMatrix();
+    for (size_t i = 0; i < n; ++i) {
+      (*inliers)[i] = std::abs(EpipolarDistance(Em, x_r[i], x_n[i])) <= thresh ? 1 : 0;
+    }
+    T = RefineMotion(T, x_r, x_n, *inliers, options.sigma_px / focal_px * 2.0);
+  }
+  const Eigen::Matrix3d Em = Hat(T.translation) * T.RotationMatrix();
+  for (size_t i = 0; i < n; ++i) {
+    (*inliers)[i] = std::abs(EpipolarDistance(Em, x_r[i], x_n[i])) <= thresh ? 1 : 0;
+  }
+  motion->cam_n_from_cam_r = T;
+  motion->translation_known = true;
+  motion->scale_known = false;
+  motion->source = RelativeMotion::Source::kTwoView;
+  motion->covariance = EpipolarCovariance(motion->cam_n_from_cam_r, x_r, x_n, *inliers,
+                                          options.sigma_px / focal_px);
+  return Status::Ok();
+}
+
+}  // namespace mbslam

@@ -1,0 +1,64 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_RELATIVE_MOTION_H_
+#define MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_RELATIVE_MOTION_H_
+
+// The motion of the camera relative to one body between a reference image r and the
+// current image n, with its uncertainty: what the constraints of thesis ch. 3 are
+// evaluated with. It comes from the body's SLAM, from odometry (sec. 3.8), or from a
+// robust two-view estimate on the body's own tracks.
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/util/status.h"
+#include "services/perception/geometry/rigid3.h"
+
+namespace mbslam {
+
+struct RelativeMotion {
+  Rigid3d cam_n_from_cam_r;                 // x_in_cam_n = cam_n_from_cam_r * x_in_cam_r
+  Matrix6d covariance = Matrix6d::Zero();   // left perturbation [t; r] of cam_n_from_cam_r
+  bool translation_known = true;            // false: pure rotation (too little parallax)
+  bool scale_known = false;                 // translation in the units of the depth bounds
+  enum class Source { kSlam, kOdometry, kTwoView } source = Source::kTwoView;
+};
+
+// A weighted sample of the motion distribution (sigma points of the covariance).
+struct MotionSample {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d E = Eigen::Matrix3d::Zero();  // [t]x R
+  double weight = 1.0;
+};
+
+// Sigma points of the motion: the mean plus +-sqrt(n + kappa) standard deviations along
+// each principal direction of the covariance (directions with negligible variance are
+// skipped). Weights sum to one.
+std::vector<MotionSample> MotionSigmaPoints(const RelativeMotion& motion, double kappa = 1.0);
+
+struct TwoViewOptions {
+  double sigma_px = 0.8;           // feature position noise (px)
+  double ransac_threshold_px = 1.5;  // inlier threshold on the epipolar distance (px)
+  double ransac_confidence = 0.999;  // RANSAC confidence
+  double min_parallax_px = 1.0;    // median rotation-compensated flow below this = pure rotation (px)
+  int min_points = 12;             // fewer correspondences: no estimate (count)
+};
+
+// Robust relative motion from normalised correspondences x_r <-> x_n (Nister 5-point
+// RANSAC, pose recovery with cheirality), or a pure rotation when the parallax is too
+// small for the translation to be observable. Translation has unit norm. The
+// covariance comes from the inliers' epipolar residuals (Gauss-Newton information).
+Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
+                              const std::vector<Eigen::Vector2d>& x_n, double focal_px,
+                              const TwoViewOptions& options, RelativeMotion* motion,
+                              std::vector<uint8_t>* inliers);
+
+// Signed distance (normalised units) of x_n to the epipolar line E x_r.
+double EpipolarDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& x_r,
+                        const Eigen::Vector2d& x_n);
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_RELATIVE_MOTION_H_

@@ -1,0 +1,77 @@
+#include "services/perception/segmentation/relative_motion.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace mbslam {
+namespace {
+
+void MakeScene(const Rigid3d& cam_n_from_cam_r, int n, double noise_norm, std::mt19937* rng,
+               std::vector<Eigen::Vector2d>* xr, std::vector<Eigen::Vector2d>* xn) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0), z(2.0, 10.0);
+  std::normal_distribution<double> g(0.0, noise_norm);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d p(u(*rng) * 3, u(*rng) * 2, z(*rng));
+    const Eigen::Vector3d q = cam_n_from_cam_r * p;
+    xr->push_back(p.hnormalized() + Eigen::Vector2d(g(*rng), g(*rng)));
+    xn->push_back(q.hnormalized() + Eigen::Vector2d(g(*rng), g(*rng)));
+  }
+}
+
+TEST(RelativeMotion, RecoversDirectionAndRotation) {
+  std::mt19937 rng(1);
+  Vector6d xi;
+  xi << 0.3, 0.05, 0.1, 0.01, -0.03, 0.02;
+  const Rigid3d truth = Rigid3d::Exp(xi);
+  std::vector<Eigen::Vector2d> xr, xn;
+  MakeScene(truth, 200, 0.5 / 500.0, &rng, &xr, &xn);
+  // 20% outliers.
+  for (int i = 0; i < 40; ++i) xn[static_cast<size_t>(i)] += Eigen::Vector2d(0.03, -0.02);
+  RelativeMotion m;
+  std::vector<uint8_t> inliers;
+  ASSERT_TRUE(EstimateRelativeMotion(xr, xn, 500.0, TwoViewOptions(), &m, &inliers).ok());
+  EXPECT_TRUE(m.translation_known);
+  EXPECT_LT(RotationDistance(m.cam_n_from_cam_r, truth), 2e-3);
+  EXPECT_GT(m.cam_n_from_cam_r.translation.dot(truth.translation.normalized()), 0.995);
+  int outliers_flagged = 0;
+  for (int i = 0; i < 40; ++i) outliers_flagged += !inliers[static_cast<size_t>(i)];
+  EXPECT_GE(outliers_flagged, 38);
+  // The covariance is positive and small on the observable directions.
+  EXPECT_GT(m.covariance.trace(), 0.0);
+  EXPECT_LT(m.covariance.trace(), 1e-2);
+}
+
+TEST(RelativeMotion, PureRotationIsDetected) {
+  std::mt19937 rng(2);
+  const Rigid3d truth(Eigen::Matrix3d(Eigen::AngleAxisd(0.02, Eigen::Vector3d(0.2, 1, 0).normalized())),
+                      Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector2d> xr, xn;
+  MakeScene(truth, 150, 0.3 / 500.0, &rng, &xr, &xn);
+  RelativeMotion m;
+  std::vector<uint8_t> inliers;
+  ASSERT_TRUE(EstimateRelativeMotion(xr, xn, 500.0, TwoViewOptions(), &m, &inliers).ok());
+  EXPECT_FALSE(m.translation_known);
+  EXPECT_LT(RotationDistance(m.cam_n_from_cam_r, truth), 1e-3);
+}
+
+TEST(RelativeMotion, SigmaPointsWeightsSumToOne) {
+  RelativeMotion m;
+  m.covariance = Matrix6d::Identity() * 1e-4;
+  m.covariance(0, 0) = 0.0;  // an unobservable direction is skipped
+  const auto samples = MotionSigmaPoints(m);
+  EXPECT_EQ(samples.size(), 11u);
+  double sum = 0.0;
+  for (const auto& s : samples) sum += s.weight;
+  EXPECT_NEAR(sum, 1.0, 1e-12);
+}
+
+TEST(RelativeMotion, TooFewPointsIsAnError) {
+  std::vector<Eigen::Vector2d> a(5, Eigen::Vector2d::Zero()), b = a;
+  RelativeMotion m;
+  std::vector<uint8_t> inl;
+  EXPECT_FALSE(EstimateRelativeMotion(a, b, 500, TwoViewOptions(), &m, &inl).ok());
+}
+
+}  // namespace
+}  // namespace mbslam
