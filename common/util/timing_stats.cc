@@ -33,7 +33,37 @@ void TimingStats::Add(double duration_ms) {
   ++total_count_;
   sum_ += duration_ms;
   max_ = std::max(max_, duration_ms);
-  if (budget_ms_ > 0.0 && duration_ms > budget_ms_) ++overruns_;
+  if (budget_ms_ > 0.0 && duration_ms > budget_ms_) {
+    ++overruns_;
+    ++total_overruns_;
+  }
+  total_sum_ += duration_ms;
+  total_max_ = std::max(total_max_, duration_ms);
+  if ((total_count_ - 1) % stride_ == 0) {
+    all_.push_back(duration_ms);
+    if (all_.size() >= 2 * max_samples_) {
+      // Keep every other sample and halve the rate.
+      for (size_t i = 0; i < all_.size() / 2; ++i) all_[i] = all_[2 * i];
+      all_.resize(all_.size() / 2);
+      stride_ *= 2;
+    }
+  }
+}
+
+TimingSummary TimingStats::Cumulative() const {
+  std::vector<double> samples;
+  TimingSummary summary;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    samples = all_;
+    summary.count = total_count_;
+    summary.mean_ms = total_count_ > 0 ? total_sum_ / static_cast<double>(total_count_) : 0.0;
+    summary.max_ms = total_max_;
+    summary.overruns = total_overruns_;
+  }
+  summary.p50_ms = Percentile(&samples, 50.0);
+  summary.p99_ms = Percentile(&samples, 99.0);
+  return summary;
 }
 
 TimingSummary TimingStats::Drain() {

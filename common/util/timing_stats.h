@@ -30,6 +30,8 @@ class TimingStats {
 
   void Add(double duration_ms);
   TimingSummary Drain();
+  // Summary since construction (a bounded, evenly thinned sample of all durations).
+  TimingSummary Cumulative() const;
   // Totals since construction (not reset by Drain).
   int64_t total_count() const;
   const std::string& name() const { return name_; }
@@ -47,6 +49,12 @@ class TimingStats {
   double sum_ = 0.0;
   double max_ = 0.0;
   int64_t total_count_ = 0;
+  // Run-long sample: every `stride_`-th duration, the stride doubling when full.
+  std::vector<double> all_;
+  int64_t stride_ = 1;
+  double total_sum_ = 0.0;
+  double total_max_ = 0.0;
+  int64_t total_overruns_ = 0;
 };
 
 }  // namespace mbslam

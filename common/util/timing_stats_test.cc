@@ -32,6 +32,19 @@ TEST(TimingStats, SummarisesAndResetsPerPeriod) {
   EXPECT_EQ(stats.total_count(), 100);
 }
 
+TEST(TimingStats, CumulativeSurvivesDrainsAndStaysBounded) {
+  TimingStats stats("stage", 0.0, /*max_samples=*/16);
+  for (int i = 0; i < 1000; ++i) {
+    stats.Add(i < 500 ? 1.0 : 3.0);
+    if (i % 100 == 0) stats.Drain();
+  }
+  const TimingSummary all = stats.Cumulative();
+  EXPECT_EQ(all.count, 1000);
+  EXPECT_DOUBLE_EQ(all.mean_ms, 2.0);
+  EXPECT_DOUBLE_EQ(all.max_ms, 3.0);
+  EXPECT_DOUBLE_EQ(all.p99_ms, 3.0);
+}
+
 TEST(TimingStats, ReservoirIsBounded) {
   TimingStats stats("stage", 0.0, /*max_samples=*/8);
   for (int i = 0; i < 100; ++i) stats.Add(1.0);

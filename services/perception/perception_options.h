@@ -44,6 +44,20 @@ struct PerceptionOptions {
   PipelineOptions pipeline;
   InputOptions input;
   PreprocessOptions preprocess;
+  TrackerOptions tracking;
+  SegmentationOptions segmentation;
+  PersonDetectorOptions person;
+  OdometryOptions odometry;
+
+  CoreOptions core() const {
+    CoreOptions c;
+    c.preprocess = preprocess;
+    c.tracking = tracking;
+    c.segmentation = segmentation;
+    c.person = person;
+    c.odometry = odometry;
+    return c;
+  }
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(service);
@@ -51,6 +65,10 @@ struct PerceptionOptions {
     MBSLAM_CHECK_OPTION_SECTION(pipeline);
     MBSLAM_CHECK_OPTION_SECTION(input);
     MBSLAM_CHECK_OPTION_SECTION(preprocess);
+    MBSLAM_CHECK_OPTION_SECTION(tracking);
+    MBSLAM_CHECK_OPTION_SECTION(segmentation);
+    MBSLAM_CHECK_OPTION_SECTION(person);
+    MBSLAM_CHECK_OPTION_SECTION(odometry);
     return true;
   }
   template <typename V>
@@ -60,6 +78,10 @@ struct PerceptionOptions {
     v("pipeline", &pipeline, "threads, queues and the frame-drop policy");
     v("input", &input, "input message handling and calibration");
     v("preprocess", &preprocess, "image pyramid and odometry buffer");
+    v("tracking", &tracking, "feature tracking (thesis ch. 2)");
+    v("segmentation", &segmentation, "multibody motion segmentation (thesis ch. 3)");
+    v("person", &person, "person detection in moving regions (thesis sec. 3.9.4)");
+    v("odometry", &odometry, "ego-motion from wheel odometry (thesis sec. 3.8)");
   }
 };
 

@@ -1,5 +1,7 @@
 #include "services/perception/perception_service.h"
 
+#include <cstdio>
+
 #include "common/util/logging.h"
 #include "common/util/shutdown.h"
 #include "common/util/time.h"
@@ -25,7 +27,7 @@ std::unique_ptr<PerceptionService> PerceptionService::Create(const PerceptionOpt
     s->output_log_ = LcmLogWriter::Open(options.service.output_log, status);
     if (!s->output_log_) return nullptr;
   }
-  s->core_ = std::make_unique<PerceptionCore>(options.preprocess, &s->counters_, &s->timers_);
+  s->core_ = std::make_unique<PerceptionCore>(options.core(), &s->counters_, &s->timers_);
   s->lcm_sink_ = std::make_unique<LcmOutputSink>(bus, s->output_log_.get(), options.channels,
                                                  options.service.publish_tracks);
   s->sink_ = std::make_unique<TeeSink>(std::vector<OutputSink*>{s->lcm_sink_.get(), &s->recorder_});
@@ -54,7 +56,17 @@ Status PerceptionService::WriteOutputs(const std::string& dir) {
   for (const auto& [name, value] : counters_.Snapshot()) {
     counters += (counters.empty() ? "" : ", ") + ("\"" + name + "\": " + std::to_string(value));
   }
-  const Status s = recorder_.Write(dir, "\"counters\": {" + counters + "}");
+  std::string timings;
+  for (const StageStatus& st : pipeline_->RunTimings()) {
+    char buf[256];
+    std::snprintf(buf, sizeof(buf),
+                  "\"%s\": {\"count\": %lld, \"mean_ms\": %.3f, \"p50_ms\": %.3f, \"p99_ms\": %.3f, \"max_ms\": %.3f}",
+                  st.name.c_str(), static_cast<long long>(st.timing.count), st.timing.mean_ms,
+                  st.timing.p50_ms, st.timing.p99_ms, st.timing.max_ms);
+    timings += (timings.empty() ? "" : ", ") + std::string(buf);
+  }
+  const Status s = recorder_.Write(
+      dir, "\"counters\": {" + counters + "},\n  \"timings\": {" + timings + "}");
   if (!s.ok()) MBSLAM_LOG(ERROR) << "writing outputs to " << dir << ": " << s.message();
   else MBSLAM_LOG(INFO) << "outputs written to " << dir;
   return s;
@@ -108,6 +120,11 @@ Status PerceptionService::Finish() {
                    << ", rejected " << last_status_.frames_rejected;
   for (const auto& [name, value] : last_status_.counters) {
     MBSLAM_LOG(INFO) << "  " << name << ": " << value;
+  }
+  for (const StageStatus& st : pipeline_->RunTimings()) {
+    MBSLAM_LOG(INFO) << "  stage " << st.name << ": n " << st.timing.count << " mean "
+                     << st.timing.mean_ms << " ms, p50 " << st.timing.p50_ms << " ms, p99 "
+                     << st.timing.p99_ms << " ms, max " << st.timing.max_ms << " ms";
   }
   return WriteOutputs(options_.service.output_dir);
 }

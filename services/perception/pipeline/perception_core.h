@@ -5,6 +5,9 @@
 // SLAM -> object tracking -> fusion -> occupancy, with their feedback paths. Runs on
 // the pipeline's processing thread; knows nothing of LCM.
 
+#include <array>
+#include <cmath>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -15,6 +18,9 @@
 #include "services/perception/pipeline/counters.h"
 #include "services/perception/pipeline/frame_processor.h"
 #include "services/perception/pipeline/stage_timers.h"
+#include "services/perception/segmentation/motion_segmenter.h"
+#include "services/perception/segmentation/person_detector.h"
+#include "services/perception/tracking/feature_tracker.h"
 
 namespace mbslam {
 
@@ -38,9 +44,58 @@ struct PreprocessOptions {
   }
 };
 
+// Ego-motion from wheel odometry (thesis sec. 3.8).
+struct OdometryOptions {
+  bool use_for_ego_motion = true;   // camera motion from odometry when it covers both images
+  std::array<double, 3> base_from_cam_translation{{0.0, 0.0, 0.0}};  // camera origin in the robot base frame (m)
+  std::array<double, 4> base_from_cam_rotation{{0.5, -0.5, 0.5, -0.5}};  // [w, x, y, z]; default: camera z forward = base x, camera x right = base -y
+  double sigma_translation_per_m = 0.02;   // odometry translation noise per metre travelled (m/m)
+  double sigma_rotation_per_rad = 0.02;    // odometry rotation noise per radian turned (rad/rad)
+  double sigma_translation_floor_m = 0.002;  // translation noise floor per image pair (m)
+  double sigma_rotation_floor_rad = 0.002;   // rotation noise floor per image pair (rad)
+  double min_depth_m = 0.3;         // nearest plausible static point (flow vector bound) (m)
+  double max_depth_m = 0.0;         // farthest plausible static point; 0 = unbounded (m)
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION_GE(sigma_translation_per_m, 0.0);
+    MBSLAM_CHECK_OPTION_GE(sigma_rotation_per_rad, 0.0);
+    MBSLAM_CHECK_OPTION_GT(sigma_translation_floor_m, 0.0);
+    MBSLAM_CHECK_OPTION_GT(sigma_rotation_floor_rad, 0.0);
+    MBSLAM_CHECK_OPTION_GE(min_depth_m, 0.0);
+    MBSLAM_CHECK_OPTION_GE(max_depth_m, 0.0);
+    const double n = std::sqrt(base_from_cam_rotation[0] * base_from_cam_rotation[0] +
+                               base_from_cam_rotation[1] * base_from_cam_rotation[1] +
+                               base_from_cam_rotation[2] * base_from_cam_rotation[2] +
+                               base_from_cam_rotation[3] * base_from_cam_rotation[3]);
+    MBSLAM_CHECK_OPTION(std::abs(n - 1.0) < 1e-6);
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("use_for_ego_motion", &use_for_ego_motion, "camera motion from odometry when available");
+    v("base_from_cam_translation", &base_from_cam_translation, "camera origin in the base frame (m)");
+    v("base_from_cam_rotation", &base_from_cam_rotation, "base_from_cam rotation [w, x, y, z]");
+    v("sigma_translation_per_m", &sigma_translation_per_m, "translation noise per metre (m/m)");
+    v("sigma_rotation_per_rad", &sigma_rotation_per_rad, "rotation noise per radian (rad/rad)");
+    v("sigma_translation_floor_m", &sigma_translation_floor_m, "translation noise floor (m)");
+    v("sigma_rotation_floor_rad", &sigma_rotation_floor_rad, "rotation noise floor (rad)");
+    v("min_depth_m", &min_depth_m, "nearest plausible static point (m)");
+    v("max_depth_m", &max_depth_m, "farthest plausible static point, 0 = unbounded (m)");
+  }
+};
+
+// The sections of the perception options the core uses.
+struct CoreOptions {
+  PreprocessOptions preprocess;
+  TrackerOptions tracking;
+  SegmentationOptions segmentation;
+  PersonDetectorOptions person;
+  OdometryOptions odometry;
+};
+
 class PerceptionCore : public FrameProcessor {
  public:
-  PerceptionCore(const PreprocessOptions& options, Counters* counters, StageTimers* timers);
+  PerceptionCore(const CoreOptions& options, Counters* counters, StageTimers* timers);
 
   void OnOdometry(const OdometrySample& odometry) override;
   FrameResult ProcessFrame(const ImageFrame& frame) override;
@@ -48,12 +103,26 @@ class PerceptionCore : public FrameProcessor {
   const PoseBuffer& odometry() const { return odometry_; }
 
  private:
-  const PreprocessOptions options_;
+  std::optional<RelativeMotion> OdometryMotion(int64_t ref_frame, int64_t cur_frame) const;
+  void Reset();
+
+  const CoreOptions options_;
   Counters* counters_;
   TimingStats* preprocess_timer_;
+  TimingStats* tracking_timer_;
+  TimingStats* segmentation_timer_;
   PoseBuffer odometry_;
+  Rigid3d base_from_cam_;
+  FeatureTracker tracker_;
+  MotionSegmenter segmenter_;
+  PersonDetector person_detector_;
   std::vector<cv::Mat> pyramid_;
-  int64_t frames_ = 0;
+  std::map<int64_t, int64_t> frame_utime_;   // frame index -> image time (recent frames)
+  std::vector<TrackingHints::Hull> occluders_;  // moving objects' hulls predicted for the next image
+  std::map<int, int64_t> person_checked_;    // object id -> frame of the last person check
+  std::map<int, bool> is_person_;
+  std::map<int, int64_t> object_first_utime_;
+  int64_t frame_index_ = -1;
 };
 
 }  // namespace mbslam

@@ -159,6 +159,13 @@ void PerceptionPipeline::ProcessLoop() {
   }
 }
 
+std::vector<StageStatus> PerceptionPipeline::RunTimings() const {
+  std::vector<StageStatus> out;
+  for (TimingStats* stage : timers_->All()) out.push_back(StageStatus{stage->name(), stage->Cumulative()});
+  out.push_back(StageStatus{"latency", latency_.Cumulative()});
+  return out;
+}
+
 PipelineStatus PerceptionPipeline::BuildStatus(int64_t wall_utime) {
   PipelineStatus s;
   s.utime = latest_utime_.load();

@@ -86,6 +86,8 @@ class PerceptionPipeline {
 
   // Builds the status for the period since the previous call (drains stage timings).
   PipelineStatus BuildStatus(int64_t wall_utime);
+  // Stage and latency timings over the whole run (for summaries and benchmarks).
+  std::vector<StageStatus> RunTimings() const;
 
   int64_t frames_processed() const { return frames_processed_.load(); }
   int64_t frames_received() const { return frames_received_.load(); }

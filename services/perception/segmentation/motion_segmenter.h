@@ -53,6 +53,7 @@ struct SegmentationOptions {
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(likelihood);
+    MBSLAM_CHECK_OPTION_SECTION(two_view);
     MBSLAM_CHECK_OPTION_GE(lag_frames, 1);
     MBSLAM_CHECK_OPTION_GT(history_frames, lag_frames);
     MBSLAM_CHECK_OPTION_GT(target_parallax_px, 0.0);

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "common/config/options.h"
 #include "common/util/status.h"
 #include "services/perception/geometry/rigid3.h"
 
@@ -44,6 +45,23 @@ struct TwoViewOptions {
   double ransac_confidence = 0.999;  // RANSAC confidence
   double min_parallax_px = 1.0;    // median rotation-compensated flow below this = pure rotation (px)
   int min_points = 12;             // fewer correspondences: no estimate (count)
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION_GT(sigma_px, 0.0);
+    MBSLAM_CHECK_OPTION_GT(ransac_threshold_px, 0.0);
+    MBSLAM_CHECK_OPTION(ransac_confidence > 0.0 && ransac_confidence < 1.0);
+    MBSLAM_CHECK_OPTION_GE(min_parallax_px, 0.0);
+    MBSLAM_CHECK_OPTION_GE(min_points, 8);
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("sigma_px", &sigma_px, "feature position noise (px)");
+    v("ransac_threshold_px", &ransac_threshold_px, "RANSAC inlier threshold, epipolar distance (px)");
+    v("ransac_confidence", &ransac_confidence, "RANSAC confidence");
+    v("min_parallax_px", &min_parallax_px, "median rotation-compensated flow below this = pure rotation (px)");
+    v("min_points", &min_points, "fewest correspondences for an estimate (count)");
+  }
 };
 
 // Robust relative motion from normalised correspondences x_r <-> x_n (Nister 5-point
