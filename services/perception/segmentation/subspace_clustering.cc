@@ -1,0 +1,280 @@
+#include "services/perception/segmentation/subspace_clustering.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <Eigen/SVD>
+
+namespace mbslam {
+
+Eigen::MatrixXd SparseSelfExpression(const Eigen::MatrixXd& Y, const SubspaceClusteringOptions& o) {
+  const Eigen::Index n = Y.cols();
+  const Eigen::MatrixXd G = Y.transpose() * Y;
+  // mu_z: the smallest over columns of the largest coherence with another column; the
+  // data weight alpha / mu_z makes alpha independent of the data's scale.
+  double mu_z = std::numeric_limits<double>::max();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double best = 0.0;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (j != i) best = std::max(best, std::abs(G(j, i)));
+    }
+    mu_z = std::min(mu_z, best);
+  }
+  if (!(mu_z > 0.0)) mu_z = 1.0;
+  const double mu1 = o.alpha / mu_z;
+  const double mu2 = o.alpha;
+  const Eigen::MatrixXd ones = Eigen::MatrixXd::Ones(n, n);
+  const Eigen::MatrixXd A =
+      (mu1 * G + mu2 * Eigen::MatrixXd::Identity(n, n) + mu2 * ones).partialPivLu().inverse();
+  const Eigen::MatrixXd M0 = A * (mu1 * G + mu2 * ones);
+  const Eigen::VectorXd A1 = A * Eigen::VectorXd::Ones(n);
+
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXd Lambda = Eigen::MatrixXd::Zero(n, n);
+  Eigen::RowVectorXd lambda3 = Eigen::RowVectorXd::Zero(n);
+  Eigen::MatrixXd Z(n, n);
+  const double shrink = 1.0 / mu2;
+  for (int iter = 0; iter < o.max_iterations; ++iter) {
+    // Z-update (least squares with the affine constraint), zero diagonal.
+    Z.noalias() = M0 + A * (mu2 * C - Lambda);
+    Z.noalias() -= A1 * lambda3;
+    Z.diagonal().setZero();
+    // C-update: soft thresholding.
+    const Eigen::MatrixXd V = Z + Lambda / mu2;
+    C = V.unaryExpr([shrink](double v) {
+      return v > shrink ? v - shrink : (v < -shrink ? v + shrink : 0.0);
+    });
+    C.diagonal().setZero();
+    // Dual updates.
+    Lambda += mu2 * (Z - C);
+    const Eigen::RowVectorXd col_sums = Z.colwise().sum();
+    lambda3 += mu2 * (col_sums - Eigen::RowVectorXd::Ones(n));
+    const double err1 = (Z - C).cwiseAbs().maxCoeff();
+    const double err2 = (col_sums.array() - 1.0).abs().maxCoeff();
+    if (err1 < o.tolerance && err2 < o.tolerance) break;
+  }
+  return C;
+}
+
+Eigen::MatrixXd LeastSquaresSelfExpression(const Eigen::MatrixXd& Y, double relative_lambda) {
+  const Eigen::Index n = Y.cols();
+  Eigen::MatrixXd G = Y.transpose() * Y;
+  const double lambda = relative_lambda * G.diagonal().mean();
+  G.diagonal().array() += lambda;
+  const Eigen::MatrixXd D = G.llt().solve(Eigen::MatrixXd::Identity(n, n));
+  Eigen::MatrixXd C(n, n);
+  for (Eigen::Index j = 0; j < n; ++j) C.col(j) = -D.col(j) / D(j, j);
+  C.diagonal().setZero();
+  return C;
+}
+
+Eigen::MatrixXd CoefficientAffinity(const Eigen::MatrixXd& C, double mass) {
+  const Eigen::Index n = C.cols();
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(n, n);
+  std::vector<Eigen::Index> order(static_cast<size_t>(n));
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const Eigen::VectorXd c = C.col(j).cwiseAbs();
+    const double total = c.sum();
+    if (total <= 0.0) continue;
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) { return c[a] > c[b]; });
+    double kept = 0.0;
+    for (Eigen::Index i : order) {
+      if (kept >= mass * total) break;
+      T(i, j) = C(i, j);
+      kept += c[i];
+    }
+  }
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double m = T.col(j).cwiseAbs().maxCoeff();
+    if (m > 0.0) T.col(j) /= m;
+  }
+  return T.cwiseAbs() + T.cwiseAbs().transpose();
+}
+
+namespace {
+
+// Eigen-decomposition of the normalised affinity D^-1/2 W D^-1/2 (eigenvalues ascending).
+Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> NormalisedAffinity(const Eigen::MatrixXd& W) {
+  const Eigen::VectorXd d = W.rowwise().sum();
+  Eigen::VectorXd dinv(d.size());
+  for (Eigen::Index i = 0; i < d.size(); ++i) dinv[i] = d[i] > 1e-12 ? 1.0 / std::sqrt(d[i]) : 0.0;
+  const Eigen::MatrixXd Nmat = dinv.asDiagonal() * W * dinv.asDiagonal();
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Nmat);
+}
+
+// k-means++ with restarts; returns labels of the lowest inertia run.
+std::vector<int> KMeans(const Eigen::MatrixXd& X, int k, int restarts, int seed) {
+  const Eigen::Index n = X.rows();
+  std::mt19937 rng(static_cast<uint32_t>(seed));
+  std::vector<int> best_labels(static_cast<size_t>(n), 0);
+  double best_inertia = std::numeric_limits<double>::max();
+  for (int r = 0; r < restarts; ++r) {
+    Eigen::MatrixXd centers(k, X.cols());
+    std::uniform_int_distribution<Eigen::Index> pick(0, n - 1);
+    centers.row(0) = X.row(pick(rng));
+    Eigen::VectorXd d2 = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::max());
+    for (int c = 1; c < k; ++c) {
+      for (Eigen::Index i = 0; i < n; ++i) {
+        d2[i] = std::min(d2[i], (X.row(i) - centers.row(c - 1)).squaredNorm());
+      }
+      std::discrete_distribution<Eigen::Index> dist(d2.data(), d2.data() + n);
+      centers.row(c) = X.row(dist(rng));
+    }
+    std::vector<int> labels(static_cast<size_t>(n), 0);
+    double inertia = 0.0;
+    for (int iter = 0; iter < 100; ++iter) {
+      bool changed = false;
+      inertia = 0.0;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        int best = 0;
+        double bd = std::numeric_limits<double>::max();
+        for (int c = 0; c < k; ++c) {
+          const double dd = (X.row(i) - centers.row(c)).squaredNorm();
+          if (dd < bd) {
+            bd = dd;
+            best = c;
+          }
+        }
+        inertia += bd;
+        if (labels[static_cast<size_t>(i)] != best) {
+          labels[static_cast<size_t>(i)] = best;
+          changed = true;
+        }
+      }
+      Eigen::MatrixXd sums = Eigen::MatrixXd::Zero(k, X.cols());
+      std::vector<int> counts(static_cast<size_t>(k), 0);
+      for (Eigen::Index i = 0; i < n; ++i) {
+        sums.row(labels[static_cast<size_t>(i)]) += X.row(i);
+        ++counts[static_cast<size_t>(labels[static_cast<size_t>(i)])];
+      }
+      for (int c = 0; c < k; ++c) {
+        if (counts[static_cast<size_t>(c)] > 0) centers.row(c) = sums.row(c) / counts[static_cast<size_t>(c)];
+        else centers.row(c) = X.row(pick(rng));  // revive an empty cluster
+      }
+      if (!changed && iter > 0) break;
+    }
+    if (inertia < best_inertia) {
+      best_inertia = inertia;
+      best_labels = labels;
+    }
+  }
+  return best_labels;
+}
+
+}  // namespace
+
+std::vector<int> SpectralClustering(const Eigen::MatrixXd& W, int k, int restarts, int seed) {
+  const Eigen::Index n = W.rows();
+  if (k <= 1 || n <= k) return std::vector<int>(static_cast<size_t>(n), 0);
+  const auto eig = NormalisedAffinity(W);
+  Eigen::MatrixXd U = eig.eigenvectors().rightCols(k);  // largest eigenvalues
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double norm = U.row(i).norm();
+    if (norm > 1e-12) U.row(i) /= norm;
+  }
+  return KMeans(U, k, restarts, seed);
+}
+
+int EstimateGroupCount(const Eigen::MatrixXd& W, int k_max) {
+  const Eigen::Index n = W.rows();
+  if (n < 3) return 1;
+  const auto eig = NormalisedAffinity(W);
+  const Eigen::VectorXd ev = eig.eigenvalues().reverse();  // descending
+  int best_k = 1;
+  double best_gap = -1.0;
+  for (int k = 1; k <= std::min<int>(k_max, static_cast<int>(n) - 1); ++k) {
+    const double gap = ev[k - 1] - ev[k];
+    if (gap > best_gap) {
+      best_gap = gap;
+      best_k = k;
+    }
+  }
+  return best_k;
+}
+
+std::vector<int> RefineBySubspaces(const Eigen::MatrixXd& Y, std::vector<int> labels, int k,
+                                   int dimension, int iterations) {
+  const Eigen::Index n = Y.cols();
+  for (int iter = 0; iter < iterations; ++iter) {
+    std::vector<Eigen::VectorXd> means(static_cast<size_t>(k));
+    std::vector<Eigen::MatrixXd> bases(static_cast<size_t>(k));
+    std::vector<bool> valid(static_cast<size_t>(k), false);
+    for (int c = 0; c < k; ++c) {
+      std::vector<Eigen::Index> members;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (labels[static_cast<size_t>(i)] == c) members.push_back(i);
+      }
+      if (static_cast<int>(members.size()) < dimension + 2) continue;
+      Eigen::MatrixXd M(Y.rows(), static_cast<Eigen::Index>(members.size()));
+      for (size_t m = 0; m < members.size(); ++m) M.col(static_cast<Eigen::Index>(m)) = Y.col(members[m]);
+      const Eigen::VectorXd mean = M.rowwise().mean();
+      M.colwise() -= mean;
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
+      const Eigen::Index d = std::min<Eigen::Index>(dimension, svd.matrixU().cols());
+      means[static_cast<size_t>(c)] = mean;
+      bases[static_cast<size_t>(c)] = svd.matrixU().leftCols(d);
+      valid[static_cast<size_t>(c)] = true;
+    }
+    bool changed = false;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      int best = labels[static_cast<size_t>(i)];
+      double best_r = std::numeric_limits<double>::max();
+      for (int c = 0; c < k; ++c) {
+        if (!valid[static_cast<size_t>(c)]) continue;
+        const Eigen::VectorXd y = Y.col(i) - means[static_cast<size_t>(c)];
+        const Eigen::MatrixXd& U = bases[static_cast<size_t>(c)];
+        const double r = (y - U * (U.transpose() * y)).squaredNorm();
+        if (r < best_r) {
+          best_r = r;
+          best = c;
+        }
+      }
+      if (best != labels[static_cast<size_t>(i)]) {
+        labels[static_cast<size_t>(i)] = best;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+  return labels;
+}
+
+std::vector<int> ClusterTrajectories(const Eigen::MatrixXd& Y, int k,
+                                     const SubspaceClusteringOptions& o, int* k_used) {
+  Eigen::MatrixXd data = Y;
+  if (k > 0 && o.projection_dims_per_motion > 0) {
+    const Eigen::Index r = std::min<Eigen::Index>(static_cast<Eigen::Index>(k) * o.projection_dims_per_motion, Y.rows());
+    if (r < Y.rows()) {
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(Y, Eigen::ComputeThinU);
+      data = svd.matrixU().leftCols(r).transpose() * Y;
+    }
+  }
+  const Eigen::MatrixXd C = o.method == "lsr" ? LeastSquaresSelfExpression(data, o.lsr_lambda)
+                                              : SparseSelfExpression(data, o);
+  const Eigen::MatrixXd W = CoefficientAffinity(C, o.coefficient_mass);
+  const int groups = k > 0 ? k : EstimateGroupCount(W, o.max_motions);
+  if (k_used) *k_used = groups;
+  std::vector<int> labels = SpectralClustering(W, groups, o.kmeans_restarts, o.seed);
+  if (o.refine_iterations > 0 && groups > 1) {
+    // The refinement corrects points the spectral step put on the wrong side of a
+    // nearby subspace; when it wants to move many points the subspaces are not
+    // separable by residual (dependent motions) and the spectral answer is kept.
+    std::vector<int> refined =
+        RefineBySubspaces(Y, labels, groups, o.subspace_dimension, o.refine_iterations);
+    size_t moved = 0;
+    for (size_t i = 0; i < labels.size(); ++i) moved += refined[i] != labels[i];
+    if (static_cast<double>(moved) <= o.max_refine_moved * static_cast<double>(labels.size())) {
+      labels = std::move(refined);
+    }
+  }
+  return labels;
+}
+
+}  // namespace mbslam

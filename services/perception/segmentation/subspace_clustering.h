@@ -1,0 +1,100 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_SUBSPACE_CLUSTERING_H_
+#define MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_SUBSPACE_CLUSTERING_H_
+
+// Multi-view multibody segmentation of feature trajectories: the initialisation step of
+// thesis sec. 3.4 (the thesis uses the algebraic RAS; this is a multi-view algebraic
+// method in the same family). Under an affine camera the trajectories of one rigid
+// motion, stacked as 2F-vectors, lie in an affine subspace of dimension <= 3, so the
+// motions are found by subspace clustering: sparse self-expression (SSC, Elhamifar &
+// Vidal) solved by ADMM, an affinity from the sparse coefficients, and normalised
+// spectral clustering. The number of motions is given, or estimated from the
+// eigengap of the affinity's normalised Laplacian.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/config/options.h"
+
+namespace mbslam {
+
+struct SubspaceClusteringOptions {
+  std::string method = "ssc";       // "ssc" (sparse, ADMM; offline quality) or "lsr" (least squares, closed form; fast)
+  double lsr_lambda = 0.005;        // LSR regularisation relative to the mean squared column norm
+  double alpha = 800.0;             // data term weight relative to the smallest coherence (SSC's alpha)
+  int max_iterations = 300;         // ADMM iterations (count)
+  double tolerance = 2e-4;          // ADMM stopping tolerance on the constraints
+  double coefficient_mass = 0.7;    // each column keeps its largest coefficients up to this share of its L1 mass
+  int projection_dims_per_motion = 4;  // project the data to this many dims per motion when k is known; 0 = none
+  int kmeans_restarts = 20;         // k-means restarts in the spectral embedding (count)
+  int max_motions = 5;              // largest number of motions considered when estimating it (count)
+  int seed = 1;                     // k-means seed (deterministic)
+  int refine_iterations = 20;       // K-subspaces refinement after spectral clustering; 0 = off (count)
+  int subspace_dimension = 4;       // dimension of one motion's trajectory subspace in the refinement (3 affine + 1 for perspective)
+  double max_refine_moved = 0.25;   // a refinement that moves more than this share of the points is rejected
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION(method == "ssc" || method == "lsr");
+    MBSLAM_CHECK_OPTION_GT(lsr_lambda, 0.0);
+    MBSLAM_CHECK_OPTION_GT(alpha, 0.0);
+    MBSLAM_CHECK_OPTION_GT(max_iterations, 0);
+    MBSLAM_CHECK_OPTION_GT(tolerance, 0.0);
+    MBSLAM_CHECK_OPTION(coefficient_mass > 0.0 && coefficient_mass <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(projection_dims_per_motion, 0);
+    MBSLAM_CHECK_OPTION_GT(kmeans_restarts, 0);
+    MBSLAM_CHECK_OPTION_GE(max_motions, 1);
+    MBSLAM_CHECK_OPTION_GE(refine_iterations, 0);
+    MBSLAM_CHECK_OPTION_GE(subspace_dimension, 1);
+    MBSLAM_CHECK_OPTION(max_refine_moved >= 0.0 && max_refine_moved <= 1.0);
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("method", &method, "ssc (sparse, ADMM) | lsr (least squares, closed form, fast)");
+    v("lsr_lambda", &lsr_lambda, "LSR regularisation relative to the mean squared column norm");
+    v("alpha", &alpha, "SSC data weight relative to the smallest coherence");
+    v("max_iterations", &max_iterations, "ADMM iterations (count)");
+    v("tolerance", &tolerance, "ADMM stopping tolerance");
+    v("coefficient_mass", &coefficient_mass, "share of each column's L1 mass kept in the affinity");
+    v("projection_dims_per_motion", &projection_dims_per_motion, "projection dims per motion when k is known (0 = none)");
+    v("kmeans_restarts", &kmeans_restarts, "k-means restarts (count)");
+    v("max_motions", &max_motions, "largest number of motions considered (count)");
+    v("seed", &seed, "k-means seed");
+    v("refine_iterations", &refine_iterations, "K-subspaces refinement iterations (0 = off)");
+    v("subspace_dimension", &subspace_dimension, "subspace dimension per motion in the refinement");
+    v("max_refine_moved", &max_refine_moved, "refinements moving more than this share are rejected");
+  }
+};
+
+// Sparse self-expressive coefficients C (N x N, zero diagonal, columns summing to one)
+// of the columns of Y (D x N).
+Eigen::MatrixXd SparseSelfExpression(const Eigen::MatrixXd& Y, const SubspaceClusteringOptions& options);
+
+// Least-squares self-expression with a zero diagonal (LSR, Lu et al. 2012), closed form:
+// C = -D diag(D)^-1 with D = (Y^T Y + lambda I)^-1, diag(C) = 0.
+Eigen::MatrixXd LeastSquaresSelfExpression(const Eigen::MatrixXd& Y, double relative_lambda);
+
+// Symmetric affinity from the coefficients: each column thresholded to its largest
+// entries holding `mass` of its L1 norm and scaled by its maximum; W = |C| + |C|^T.
+Eigen::MatrixXd CoefficientAffinity(const Eigen::MatrixXd& C, double mass);
+
+// Normalised spectral clustering (Ng, Jordan, Weiss) into k groups; labels 0..k-1.
+std::vector<int> SpectralClustering(const Eigen::MatrixXd& W, int k, int restarts, int seed);
+
+// Number of groups in [1, k_max] with the largest eigengap of the normalised Laplacian.
+int EstimateGroupCount(const Eigen::MatrixXd& W, int k_max);
+
+// K-subspaces refinement: each point moves to the affine subspace (of the given
+// dimension, fitted to the current groups) that explains it best, until stable.
+std::vector<int> RefineBySubspaces(const Eigen::MatrixXd& Y, std::vector<int> labels, int k,
+                                   int dimension, int iterations);
+
+// The whole method on trajectories Y (2F x N). k <= 0: estimate the number of motions.
+std::vector<int> ClusterTrajectories(const Eigen::MatrixXd& Y, int k,
+                                     const SubspaceClusteringOptions& options, int* k_used = nullptr);
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_SUBSPACE_CLUSTERING_H_
