@@ -16,18 +16,11 @@
 #include <vector>
 
 #include "drivers/common/pose_files.h"
+#include "drivers/common/test_util.h"
 #include "services/perception/geometry/rigid3.h"
 
 namespace mbslam {
 namespace testing_util {
-
-inline std::string MakeTempDir(const std::string& tag) {
-  std::string pattern = "/tmp/mbslam_" + tag + "_XXXXXX";
-  std::vector<char> buf(pattern.begin(), pattern.end());
-  buf.push_back('\0');
-  const char* dir = mkdtemp(buf.data());
-  return dir ? std::string(dir) : std::string();
-}
 
 // Noise plus a gradient, different for every seed: compression and off-by-one
 // errors cannot hide in it.
@@ -42,10 +35,6 @@ inline cv::Mat MakeTestImage(int width, int height, int channels, int seed) {
     }
   }
   return image;
-}
-
-inline void WriteTextFile(const std::string& path, const std::string& text) {
-  std::ofstream(path) << text;
 }
 
 inline std::string FrameName(int index, const char* ext) {

@@ -2,7 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <stdlib.h>
+#include <unistd.h>
+
 #include <cstdio>
+#include <string>
 
 #include "common/util/time.h"
 
@@ -48,6 +53,28 @@ TEST(ProgressBar, DrawsNothingWhenNotATerminal) {
   }
   EXPECT_EQ(std::ftell(f), 0);
   std::fclose(f);
+}
+
+TEST(ProgressBar, DrawsOnATerminal) {
+  const int master = posix_openpt(O_RDWR | O_NOCTTY);
+  if (master < 0 || grantpt(master) != 0 || unlockpt(master) != 0) GTEST_SKIP() << "no pseudo-terminal";
+  FILE* terminal = std::fopen(ptsname(master), "w");
+  ASSERT_NE(terminal, nullptr);
+  {
+    ProgressBar bar(true, terminal);
+    EXPECT_TRUE(bar.active());
+    bar.Update(5, 10, "bad 0");
+    bar.Update(10, 10, "bad 0");  // the last update is always drawn
+  }
+  std::fclose(terminal);
+  fcntl(master, F_SETFL, O_NONBLOCK);
+  std::string text;
+  char buf[1024];
+  for (ssize_t n; (n = read(master, buf, sizeof(buf))) > 0;) text.append(buf, static_cast<size_t>(n));
+  close(master);
+  EXPECT_NE(text.find("5/10"), std::string::npos) << text;
+  EXPECT_NE(text.find("10/10 100.0 %"), std::string::npos) << text;
+  EXPECT_NE(text.find("bad 0"), std::string::npos) << text;
 }
 
 }  // namespace

@@ -17,10 +17,20 @@
 namespace mbslam {
 namespace testing_util {
 
-// $MBSLAM_BIN_DIR/<name> (CTest sets it), else build/bin/<name>.
+// $MBSLAM_BIN_DIR/<name> (CTest sets it), else <build>/bin/<name> next to the
+// <build>/tests folder this test runs from.
 inline std::string BinPath(const std::string& name) {
   const char* dir = std::getenv("MBSLAM_BIN_DIR");
-  return std::string(dir && *dir ? dir : "build/bin") + "/" + name;
+  if (dir && *dir) return std::string(dir) + "/" + name;
+  char self[4096];
+  const ssize_t n = readlink("/proc/self/exe", self, sizeof(self) - 1);
+  if (n > 0) {
+    std::string path(self, static_cast<size_t>(n));
+    path = path.substr(0, path.rfind('/'));          // <build>/tests
+    path = path.substr(0, path.rfind('/')) + "/bin";  // <build>/bin
+    return path + "/" + name;
+  }
+  return "build/bin/" + name;
 }
 
 inline std::string ReadWholeFile(const std::string& path) {
@@ -36,47 +46,73 @@ struct ProcessResult {
   std::string err;
 };
 
+// A child process with stdout and stderr going to temporary files.
+class ChildProcess {
+ public:
+  explicit ChildProcess(const std::vector<std::string>& argv) {
+    char out_name[] = "/tmp/mbslam_proc_out_XXXXXX";
+    char err_name[] = "/tmp/mbslam_proc_err_XXXXXX";
+    const int out_fd = mkstemp(out_name);
+    const int err_fd = mkstemp(err_name);
+    out_path_ = out_name;
+    err_path_ = err_name;
+    pid_ = fork();
+    if (pid_ == 0) {
+      dup2(out_fd, STDOUT_FILENO);
+      dup2(err_fd, STDERR_FILENO);
+      std::vector<char*> args;
+      for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+      args.push_back(nullptr);
+      execv(args[0], args.data());
+      _exit(127);
+    }
+    close(out_fd);
+    close(err_fd);
+  }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+  ~ChildProcess() {
+    if (!waited_) Wait(0.0);
+  }
+
+  // Waits up to timeout_s, then kills it (exit_code -1 then).
+  ProcessResult Wait(double timeout_s) {
+    ProcessResult result;
+    int status = 0;
+    bool done = false;
+    const int steps = static_cast<int>(timeout_s * 100);
+    for (int i = 0; i <= steps && !done; ++i) {
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        done = true;
+      } else if (i < steps) {
+        usleep(10000);
+      }
+    }
+    if (!done) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, &status, 0);
+    } else if (WIFEXITED(status)) {
+      result.exit_code = WEXITSTATUS(status);
+    }
+    waited_ = true;
+    result.out = ReadWholeFile(out_path_);
+    result.err = ReadWholeFile(err_path_);
+    unlink(out_path_.c_str());
+    unlink(err_path_.c_str());
+    return result;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  bool waited_ = false;
+  std::string out_path_, err_path_;
+};
+
 // Runs argv[0] with the arguments, stdout and stderr captured, killed after
 // timeout_s (exit_code -1 then).
 inline ProcessResult RunProcess(const std::vector<std::string>& argv, double timeout_s = 60.0) {
-  ProcessResult result;
-  char out_name[] = "/tmp/mbslam_proc_out_XXXXXX";
-  char err_name[] = "/tmp/mbslam_proc_err_XXXXXX";
-  const int out_fd = mkstemp(out_name);
-  const int err_fd = mkstemp(err_name);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    dup2(out_fd, STDOUT_FILENO);
-    dup2(err_fd, STDERR_FILENO);
-    std::vector<char*> args;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    execv(args[0], args.data());
-    _exit(127);
-  }
-  int status = 0;
-  const int steps = static_cast<int>(timeout_s * 100);
-  bool done = false;
-  for (int i = 0; i < steps && !done; ++i) {
-    if (waitpid(pid, &status, WNOHANG) == pid) {
-      done = true;
-    } else {
-      usleep(10000);
-    }
-  }
-  if (!done) {
-    kill(pid, SIGKILL);
-    waitpid(pid, &status, 0);
-  } else if (WIFEXITED(status)) {
-    result.exit_code = WEXITSTATUS(status);
-  }
-  close(out_fd);
-  close(err_fd);
-  result.out = ReadWholeFile(out_name);
-  result.err = ReadWholeFile(err_name);
-  unlink(out_name);
-  unlink(err_name);
-  return result;
+  ChildProcess child(argv);
+  return child.Wait(timeout_s);
 }
 
 }  // namespace testing_util
