@@ -91,6 +91,9 @@ int Run(int argc, char** argv) {
     else if (a == "--ssc-mass" && i + 1 < argc) sc_options.coefficient_mass = std::atof(argv[++i]);
     else if (a == "--method" && i + 1 < argc) sc_options.method = argv[++i];
     else if (a == "--lsr-lambda" && i + 1 < argc) sc_options.lsr_lambda = std::atof(argv[++i]);
+    else if (a == "--merge-ratio" && i + 1 < argc) sc_options.merge_ratio = std::atof(argv[++i]);
+    else if (a == "--order" && i + 1 < argc) sc_options.order_selection = argv[++i];
+    else if (a == "--max-motions" && i + 1 < argc) sc_options.max_motions = std::atoi(argv[++i]);
     else if (a == "--refine" && i + 1 < argc) sc_options.refine_iterations = std::atoi(argv[++i]);
     else if (a == "--subspace-dim" && i + 1 < argc) sc_options.subspace_dimension = std::atoi(argv[++i]);
     else {

@@ -1,8 +1,11 @@
 #include "services/perception/segmentation/motion_segmenter.h"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <numeric>
+
+#include <Eigen/SVD>
 
 #include "services/perception/geometry/polygon.h"
 
@@ -29,6 +32,8 @@ void MotionSegmenter::Reset() {
   body_of_track_.clear();
   initialized_ = false;
   frame_ = -1;
+  first_frame_ = -1;
+  last_multibody_frame_ = -1;
 }
 
 double MotionSegmenter::BayesUpdate(double prior, double likelihood, double parallax_px) const {
@@ -73,7 +78,8 @@ void MotionSegmenter::UpdateHistories(const SegmenterInput& in) {
     t.xy.push_back(o.xy);
     t.uv.push_back(o.uv);
     t.last_frame = in.frame_index;
-    while (static_cast<int>(t.frames.size()) > options_.history_frames) {
+    const int keep = std::max(options_.history_frames, options_.multibody_init ? options_.multibody_max_frames : 0);
+    while (static_cast<int>(t.frames.size()) > keep) {
       t.frames.erase(t.frames.begin());
       t.xy.erase(t.xy.begin());
       t.uv.erase(t.uv.begin());
@@ -344,8 +350,146 @@ int64_t MotionSegmenter::ChooseReference(const SegmenterInput& in) const {
   return ref;
 }
 
+bool MotionSegmenter::MultibodyInitialize(const SegmenterInput& in) {
+  const int64_t n = in.frame_index;
+  const int64_t window = std::min<int64_t>(options_.multibody_max_frames, n - first_frame_ + 1);
+  if (window < options_.multibody_min_frames) return false;
+  const int64_t start = n - window + 1;
+  // Tracks observed in every frame of the window (histories are consecutive per track
+  // only when they have no gaps; check the count and the first frame).
+  std::vector<const TrackState*> complete;
+  for (const TrackObservation& o : in.observations) {
+    const TrackState& t = tracks_.at(o.id);
+    if (t.frames.size() < static_cast<size_t>(window)) continue;
+    const size_t first = t.frames.size() - static_cast<size_t>(window);
+    if (t.frames[first] != start) continue;
+    complete.push_back(&t);
+  }
+  if (static_cast<int>(complete.size()) < options_.multibody_min_tracks) return false;
+  std::sort(complete.begin(), complete.end(),
+            [](const TrackState* a, const TrackState* b) { return a->id < b->id; });
+  auto column = [&](const TrackState* t) {
+    Eigen::VectorXd y(2 * window);
+    const size_t first = t->frames.size() - static_cast<size_t>(window);
+    for (int64_t f = 0; f < window; ++f) {
+      y[2 * f] = t->uv[first + static_cast<size_t>(f)].x();
+      y[2 * f + 1] = t->uv[first + static_cast<size_t>(f)].y();
+    }
+    return y;
+  };
+  // Deterministic subsample: every s-th track by id.
+  const size_t stride = (complete.size() + options_.multibody_max_tracks - 1) / options_.multibody_max_tracks;
+  std::vector<const TrackState*> sample;
+  for (size_t i = 0; i < complete.size(); i += std::max<size_t>(1, stride)) sample.push_back(complete[i]);
+  Eigen::MatrixXd Y(2 * window, static_cast<Eigen::Index>(sample.size()));
+  for (size_t c = 0; c < sample.size(); ++c) Y.col(static_cast<Eigen::Index>(c)) = column(sample[c]);
+  int k = 1;
+  const std::vector<int> sample_labels = ClusterTrajectories(Y, 0, options_.multibody, &k);
+  if (k <= 1) return true;  // one motion: nothing to add to the per-image evidence
+
+  // Every complete track joins the group whose subspace explains it best.
+  const int dim = options_.multibody.subspace_dimension;
+  std::vector<Eigen::VectorXd> means(static_cast<size_t>(k));
+  std::vector<Eigen::MatrixXd> bases(static_cast<size_t>(k));
+  std::vector<int> sizes(static_cast<size_t>(k), 0);
+  for (int g = 0; g < k; ++g) {
+    std::vector<Eigen::Index> members;
+    for (size_t c = 0; c < sample.size(); ++c) {
+      if (sample_labels[c] == g) members.push_back(static_cast<Eigen::Index>(c));
+    }
+    sizes[static_cast<size_t>(g)] = static_cast<int>(members.size());
+    if (members.empty()) continue;
+    Eigen::MatrixXd M(Y.rows(), static_cast<Eigen::Index>(members.size()));
+    for (size_t m = 0; m < members.size(); ++m) M.col(static_cast<Eigen::Index>(m)) = Y.col(members[m]);
+    means[static_cast<size_t>(g)] = M.rowwise().mean();
+    M.colwise() -= means[static_cast<size_t>(g)];
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
+    bases[static_cast<size_t>(g)] = svd.matrixU().leftCols(std::min<Eigen::Index>(dim, svd.matrixU().cols()));
+  }
+  // Groups too small to be objects are absorbed by the best-fitting larger group.
+  std::vector<bool> usable(static_cast<size_t>(k));
+  for (int g = 0; g < k; ++g) usable[static_cast<size_t>(g)] = sizes[static_cast<size_t>(g)] >= std::max(dim + 2, options_.min_object_tracks);
+  if (std::none_of(usable.begin(), usable.end(), [](bool u) { return u; })) return false;
+  std::map<int, std::vector<TrackState*>> groups;
+  for (const TrackState* tc : complete) {
+    const Eigen::VectorXd y = column(tc);
+    int best = -1;
+    double best_r = std::numeric_limits<double>::max();
+    for (int g = 0; g < k; ++g) {
+      if (!usable[static_cast<size_t>(g)]) continue;
+      const Eigen::VectorXd d = y - means[static_cast<size_t>(g)];
+      const Eigen::MatrixXd& U = bases[static_cast<size_t>(g)];
+      const double r = (d - U * (U.transpose() * d)).squaredNorm();
+      if (r < best_r) {
+        best_r = r;
+        best = g;
+      }
+    }
+    groups[best].push_back(const_cast<TrackState*>(tc));
+  }
+  // The static world: the group holding most of the currently static tracks (the
+  // largest group at start-up).
+  int world = -1;
+  size_t best_score = 0;
+  for (const auto& [g, members] : groups) {
+    size_t score = 0;
+    for (const TrackState* t : members) score += initialized_ ? (!t->moving ? 1 : 0) : 1;
+    if (world < 0 || score > best_score || (score == best_score && members.size() > groups[world].size())) {
+      world = g;
+      best_score = score;
+    }
+  }
+  // The grouping is evidence fused with each track's posterior (log-odds), not a
+  // verdict: a track that the per-image constraints already know well is not flipped
+  // by one clustering.
+  auto fuse = [this](TrackState* t, double delta) {
+    const double lo = std::log(t->p_static / (1.0 - t->p_static)) + delta;
+    t->p_static = std::clamp(1.0 / (1.0 + std::exp(-lo)), 1.0 - options_.p_clamp, options_.p_clamp);
+    if (t->moving && t->p_static >= options_.static_enter) t->moving = false;
+    else if (!t->moving && t->p_static < options_.static_leave) t->moving = true;
+  };
+  for (auto& [g, members] : groups) {
+    if (g == world) {
+      for (TrackState* t : members) {
+        fuse(t, options_.multibody_evidence);
+        if (!t->moving) t->object = 0;
+      }
+      continue;
+    }
+    // Object identity by the majority of previous memberships.
+    std::map<int, int> votes;
+    for (const TrackState* t : members) {
+      if (t->object > 0 && objects_.count(t->object)) ++votes[t->object];
+    }
+    int id = 0, best = 0;
+    for (const auto& [oid, v] : votes) {
+      if (v > best) {
+        best = v;
+        id = oid;
+      }
+    }
+    if (id == 0 || 2 * best < static_cast<int>(members.size())) {
+      id = next_object_id_++;
+      ObjectState obj;
+      obj.id = id;
+      obj.first_frame = n;
+      objects_[id] = obj;
+    }
+    ObjectState& obj = objects_[id];
+    obj.confirmed = true;
+    obj.confirmations = std::max(obj.confirmations, options_.confirm_frames);
+    obj.last_frame = n;
+    for (TrackState* t : members) {
+      fuse(t, -options_.multibody_evidence);
+      if (t->moving) t->object = id;
+    }
+  }
+  return true;
+}
+
 SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
   frame_ = in.frame_index;
+  if (first_frame_ < 0) first_frame_ = in.frame_index;
   UpdateHistories(in);
   SegmentationResult result;
   result.frame_index = in.frame_index;
@@ -391,6 +535,15 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
     }
     UpdateObjectModels(in, ref);
     ClusterUnexplained(in, ref);
+  }
+  if (options_.multibody_init &&
+      (last_multibody_frame_ < 0 ||
+       (options_.multibody_every_frames > 0 &&
+        in.frame_index - last_multibody_frame_ >= options_.multibody_every_frames))) {
+    if (MultibodyInitialize(in)) {
+      last_multibody_frame_ = in.frame_index;
+      initialized_ = true;
+    }
   }
   result.initialized = initialized_;
 

@@ -25,12 +25,21 @@
 #include "common/config/options.h"
 #include "services/perception/segmentation/relative_motion.h"
 #include "services/perception/segmentation/static_likelihood.h"
+#include "services/perception/segmentation/subspace_clustering.h"
 
 namespace mbslam {
 
 struct SegmentationOptions {
   StaticLikelihoodOptions likelihood;
   TwoViewOptions two_view;
+  SubspaceClusteringOptions multibody;  // multi-view multibody initialisation (sec. 3.4)
+  bool multibody_init = true;       // (re)initialise the bodies by subspace clustering of the track window
+  int multibody_min_frames = 10;    // window length needed for the first initialisation (frames)
+  int multibody_max_frames = 30;    // longest window used (frames)
+  int multibody_every_frames = 10;  // re-initialisation period (frames); 0 = only once
+  int multibody_max_tracks = 250;   // tracks clustered (subsampled beyond; the rest join by residual) (count)
+  int multibody_min_tracks = 20;    // fewer complete tracks: no initialisation (count)
+  double multibody_evidence = 3.0;  // log-odds added for / against static by a multibody grouping
   int lag_frames = 3;               // reference image at least this many images back (frames)
   int history_frames = 16;          // per-track history kept; the reference is at most this far back (frames)
   double target_parallax_px = 12.0; // the reference goes back until static tracks moved this much (px)
@@ -54,6 +63,13 @@ struct SegmentationOptions {
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(likelihood);
     MBSLAM_CHECK_OPTION_SECTION(two_view);
+    MBSLAM_CHECK_OPTION_SECTION(multibody);
+    MBSLAM_CHECK_OPTION_GE(multibody_min_frames, 2);
+    MBSLAM_CHECK_OPTION_GE(multibody_max_frames, multibody_min_frames);
+    MBSLAM_CHECK_OPTION_GE(multibody_every_frames, 0);
+    MBSLAM_CHECK_OPTION_GE(multibody_max_tracks, multibody_min_tracks);
+    MBSLAM_CHECK_OPTION_GE(multibody_min_tracks, 8);
+    MBSLAM_CHECK_OPTION_GT(multibody_evidence, 0.0);
     MBSLAM_CHECK_OPTION_GE(lag_frames, 1);
     MBSLAM_CHECK_OPTION_GT(history_frames, lag_frames);
     MBSLAM_CHECK_OPTION_GT(target_parallax_px, 0.0);
@@ -73,6 +89,14 @@ struct SegmentationOptions {
   void VisitFields(V& v) {
     v("likelihood", &likelihood, "epipolar + Flow Vector Bound likelihood");
     v("two_view", &two_view, "robust two-view motion estimate");
+    v("multibody", &multibody, "multi-view multibody initialisation (subspace clustering)");
+    v("multibody_init", &multibody_init, "(re)initialise bodies by clustering the track window");
+    v("multibody_min_frames", &multibody_min_frames, "window for the first initialisation (frames)");
+    v("multibody_max_frames", &multibody_max_frames, "longest clustering window (frames)");
+    v("multibody_every_frames", &multibody_every_frames, "re-initialisation period, 0 = once (frames)");
+    v("multibody_max_tracks", &multibody_max_tracks, "tracks clustered, the rest join by residual (count)");
+    v("multibody_min_tracks", &multibody_min_tracks, "complete tracks needed (count)");
+    v("multibody_evidence", &multibody_evidence, "log-odds a multibody grouping adds for / against static");
     v("lag_frames", &lag_frames, "reference image this many images back (frames)");
     v("history_frames", &history_frames, "per-track history; longest reference lag (frames)");
     v("target_parallax_px", &target_parallax_px, "reference goes back until static tracks moved this much (px)");
@@ -188,6 +212,9 @@ class MotionSegmenter {
   // `parallax_px`: how much the pair could tell; static evidence from pairs with little
   // parallax is discounted (they cannot reveal a degenerate mover yet).
   double BayesUpdate(double prior, double likelihood, double parallax_px) const;
+  // Sec. 3.4: segments the tracks complete over the recent window into motions, picks
+  // the static world and (re)labels tracks and objects. Returns false if it did not run.
+  bool MultibodyInitialize(const SegmenterInput& input);
   int64_t ChooseReference(const SegmenterInput& input) const;
 
   const SegmentationOptions options_;
@@ -196,6 +223,8 @@ class MotionSegmenter {
   std::unordered_map<int64_t, int> body_of_track_;
   int next_object_id_ = 1;
   int64_t frame_ = -1;
+  int64_t first_frame_ = -1;
+  int64_t last_multibody_frame_ = -1;
   bool initialized_ = false;
 };
 

@@ -246,6 +246,59 @@ std::vector<int> RefineBySubspaces(const Eigen::MatrixXd& Y, std::vector<int> la
   return labels;
 }
 
+double SubspaceResidual(const Eigen::MatrixXd& Y, const std::vector<int>& labels, int group,
+                        int dimension) {
+  std::vector<Eigen::Index> members;
+  for (Eigen::Index i = 0; i < Y.cols(); ++i) {
+    if (labels[static_cast<size_t>(i)] == group) members.push_back(i);
+  }
+  if (static_cast<int>(members.size()) <= dimension + 1) return 0.0;
+  Eigen::MatrixXd M(Y.rows(), static_cast<Eigen::Index>(members.size()));
+  for (size_t m = 0; m < members.size(); ++m) M.col(static_cast<Eigen::Index>(m)) = Y.col(members[m]);
+  M.colwise() -= M.rowwise().mean();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
+  double r = 0.0;
+  for (Eigen::Index j = dimension; j < svd.singularValues().size(); ++j) {
+    r += svd.singularValues()[j] * svd.singularValues()[j];
+  }
+  return r / static_cast<double>(members.size());
+}
+
+std::vector<int> MergeGroups(const Eigen::MatrixXd& Y, std::vector<int> labels, int dimension,
+                             double merge_ratio, int* groups) {
+  int k = 0;
+  for (int l : labels) k = std::max(k, l + 1);
+  while (k > 1) {
+    double best_ratio = std::numeric_limits<double>::max();
+    int best_a = -1, best_b = -1;
+    for (int a = 0; a < k; ++a) {
+      for (int b = a + 1; b < k; ++b) {
+        std::vector<int> merged = labels;
+        for (int& l : merged) {
+          if (l == b) l = a;
+        }
+        const double separate = std::max(SubspaceResidual(Y, labels, a, dimension),
+                                         SubspaceResidual(Y, labels, b, dimension));
+        const double joint = SubspaceResidual(Y, merged, a, dimension);
+        const double ratio = joint / std::max(separate, 1e-12);
+        if (ratio < best_ratio) {
+          best_ratio = ratio;
+          best_a = a;
+          best_b = b;
+        }
+      }
+    }
+    if (best_ratio > merge_ratio) break;
+    for (int& l : labels) {
+      if (l == best_b) l = best_a;
+      else if (l == k - 1 && best_b != k - 1) l = best_b;  // keep labels 0..k-2
+    }
+    --k;
+  }
+  *groups = k;
+  return labels;
+}
+
 std::vector<int> ClusterTrajectories(const Eigen::MatrixXd& Y, int k,
                                      const SubspaceClusteringOptions& o, int* k_used) {
   Eigen::MatrixXd data = Y;
@@ -259,9 +312,13 @@ std::vector<int> ClusterTrajectories(const Eigen::MatrixXd& Y, int k,
   const Eigen::MatrixXd C = o.method == "lsr" ? LeastSquaresSelfExpression(data, o.lsr_lambda)
                                               : SparseSelfExpression(data, o);
   const Eigen::MatrixXd W = CoefficientAffinity(C, o.coefficient_mass);
-  const int groups = k > 0 ? k : EstimateGroupCount(W, o.max_motions);
-  if (k_used) *k_used = groups;
+  int groups = k > 0 ? k : (o.order_selection == "eigengap" ? EstimateGroupCount(W, o.max_motions) : o.max_motions);
   std::vector<int> labels = SpectralClustering(W, groups, o.kmeans_restarts, o.seed);
+  if (k <= 0 && o.order_selection == "merge") {
+    labels = RefineBySubspaces(Y, std::move(labels), groups, o.subspace_dimension, o.refine_iterations);
+    labels = MergeGroups(Y, std::move(labels), o.subspace_dimension, o.merge_ratio, &groups);
+  }
+  if (k_used) *k_used = groups;
   if (o.refine_iterations > 0 && groups > 1) {
     // The refinement corrects points the spectral step put on the wrong side of a
     // nearby subspace; when it wants to move many points the subspaces are not

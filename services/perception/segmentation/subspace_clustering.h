@@ -34,6 +34,8 @@ struct SubspaceClusteringOptions {
   int refine_iterations = 20;       // K-subspaces refinement after spectral clustering; 0 = off (count)
   int subspace_dimension = 4;       // dimension of one motion's trajectory subspace in the refinement (3 affine + 1 for perspective)
   double max_refine_moved = 0.25;   // a refinement that moves more than this share of the points is rejected
+  std::string order_selection = "merge";  // unknown k: "merge" (over-segment, merge by residual) or "eigengap"
+  double merge_ratio = 2.0;         // merge two groups while one subspace fits them within this factor of two
 
   bool Check() const {
     MBSLAM_CHECK_OPTION(method == "ssc" || method == "lsr");
@@ -48,6 +50,8 @@ struct SubspaceClusteringOptions {
     MBSLAM_CHECK_OPTION_GE(refine_iterations, 0);
     MBSLAM_CHECK_OPTION_GE(subspace_dimension, 1);
     MBSLAM_CHECK_OPTION(max_refine_moved >= 0.0 && max_refine_moved <= 1.0);
+    MBSLAM_CHECK_OPTION(order_selection == "merge" || order_selection == "eigengap");
+    MBSLAM_CHECK_OPTION_GT(merge_ratio, 1.0);
     return true;
   }
   template <typename V>
@@ -65,6 +69,8 @@ struct SubspaceClusteringOptions {
     v("refine_iterations", &refine_iterations, "K-subspaces refinement iterations (0 = off)");
     v("subspace_dimension", &subspace_dimension, "subspace dimension per motion in the refinement");
     v("max_refine_moved", &max_refine_moved, "refinements moving more than this share are rejected");
+    v("order_selection", &order_selection, "unknown number of motions: merge | eigengap");
+    v("merge_ratio", &merge_ratio, "merge groups while one subspace fits them within this factor");
   }
 };
 
@@ -90,6 +96,16 @@ int EstimateGroupCount(const Eigen::MatrixXd& W, int k_max);
 // dimension, fitted to the current groups) that explains it best, until stable.
 std::vector<int> RefineBySubspaces(const Eigen::MatrixXd& Y, std::vector<int> labels, int k,
                                    int dimension, int iterations);
+
+// Mean squared residual per point of the trajectories of each group to its best
+// affine subspace of the given dimension.
+double SubspaceResidual(const Eigen::MatrixXd& Y, const std::vector<int>& labels, int group, int dimension);
+
+// Model order by merging: starting from an over-segmentation into k_max groups, the
+// pair of groups whose union is best explained by one subspace is merged while the
+// union's residual stays within `merge_ratio` of the separate fits.
+std::vector<int> MergeGroups(const Eigen::MatrixXd& Y, std::vector<int> labels, int dimension,
+                             double merge_ratio, int* groups);
 
 // The whole method on trajectories Y (2F x N). k <= 0: estimate the number of motions.
 std::vector<int> ClusterTrajectories(const Eigen::MatrixXd& Y, int k,
