@@ -81,8 +81,10 @@ void Json::DumpTo(std::string* out) const {
       if (!std::isfinite(double_)) {
         *out += "null";
       } else {
+        // Shortest of %.15g / %.17g that reads back as the same double.
         char buf[32];
-        std::snprintf(buf, sizeof(buf), "%.9g", double_);
+        std::snprintf(buf, sizeof(buf), "%.15g", double_);
+        if (std::strtod(buf, nullptr) != double_) std::snprintf(buf, sizeof(buf), "%.17g", double_);
         *out += buf;
       }
       break;

@@ -61,7 +61,8 @@ struct GtCheckReport {
   // Pixel grid.
   int64_t pixels = 0;                   // pixels ray-cast (count)
   int64_t pixel_label_mismatches = 0;   // rendered id != ray-cast id (count)
-  int64_t pixel_label_mismatches_on_edges = 0;  // ... of them within 0.01 px of a quad edge (count)
+  int64_t pixel_label_mismatches_on_edges = 0;  // ... of them within 0.02 px of a silhouette (count)
+  int64_t pixel_depth_skipped_on_edges = 0;     // same id, depth of a surface 0.02 px away (count)
   double depth_max_abs_error_m = 0.0;   // largest |rendered depth - ray-cast depth| (m)
   double depth_max_rel_error = 0.0;     // largest relative depth error
   double pixel_backprojection_max_px = 0.0;  // largest |project(rendered point) - pixel centre| (px)

@@ -17,10 +17,22 @@ namespace mbslam {
 namespace sim {
 namespace {
 
-// One simulator per scenario and size for the whole test binary (creation builds textures).
+// One simulator per scenario and size for the whole test binary (creation builds
+// textures). The cache is emptied before exit: GL contexts must not be destroyed during
+// static destruction, after the driver has shut down.
+std::map<std::pair<std::string, int>, std::unique_ptr<Simulator>>& Cache() {
+  static auto* cache = new std::map<std::pair<std::string, int>, std::unique_ptr<Simulator>>();
+  return *cache;
+}
+
+class ClearCache : public ::testing::Environment {
+ public:
+  void TearDown() override { Cache().clear(); }
+};
+const auto* const kClearCache = ::testing::AddGlobalTestEnvironment(new ClearCache);
+
 Simulator* Get(const std::string& scenario, int width = 320) {
-  static std::map<std::pair<std::string, int>, std::unique_ptr<Simulator>> cache;
-  auto& slot = cache[{scenario, width}];
+  auto& slot = Cache()[{scenario, width}];
   if (!slot) {
     SimOptions o;
     o.scenario = scenario;

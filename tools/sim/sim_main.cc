@@ -50,6 +50,7 @@ void Usage() {
   --check-frames N        frames checked, evenly spread (default 10)
   --json FILE             also write the final JSON object to FILE
   --quiet                 less logging and no human summary
+  --verbose               debug logging
 )";
 }
 
@@ -110,6 +111,7 @@ int main(int argc, char** argv) {
     else if (a == "--check") check = true;
     else if (a == "--check-frames") check_frames = std::atoi(next().c_str());
     else if (a == "--quiet") quiet = true;
+    else if (a == "--verbose") mbslam::SetLogLevel(mbslam::LogLevel::kDebug);
     else if (a == "--json") json_file = next();
     else if (a == "-h" || a == "--help") {
       Usage();

@@ -1,0 +1,596 @@
+// mbslam-eval: the evaluation toolkit on the command line. Every subcommand prints a
+// human summary and, as its last line, one JSON object.
+//
+//   mbslam-eval ate --est est.tum --gt gt.tum [--align sim3|se3|none] [--plot out.png]
+//   mbslam-eval ate --est-log run.lcmlog --gt-log seq.lcmlog
+//   mbslam-eval seg --pred labels.txt --truth seq.tracks.txt
+//   mbslam-eval seg --pred-dir predictions/ --tracks-dir ../shared/data/hopkins155
+//   mbslam-eval masks --pred-dir masks/ --gt-dir ../shared/data/davis2016/Annotations/camel
+//   mbslam-eval objects --est-log run.lcmlog --gt-log seq.lcmlog
+//   mbslam-eval perturb --in gt.tum --out est.tum --scale 2 --rot-deg 30 --noise 0.05
+//   mbslam-eval perturb-labels --truth seq.tracks.txt --out pred.txt --wrong 5
+//   mbslam-eval datasets
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/lcm/channels.h"
+#include "common/util/atomic_file.h"
+#include "tools/eval/camera_metrics.h"
+#include "tools/eval/datasets.h"
+#include "tools/eval/json.h"
+#include "tools/eval/lcm_readers.h"
+#include "tools/eval/object_metrics.h"
+#include "tools/eval/perturb.h"
+#include "tools/eval/plot.h"
+#include "tools/eval/segmentation_metrics.h"
+
+namespace {
+
+using mbslam::Status;
+namespace eval = mbslam::eval;
+namespace fs = std::filesystem;
+using eval::Json;
+
+// --key value arguments (and bare --flags) after the subcommand.
+class Args {
+ public:
+  Args(int argc, char** argv, int first) {
+    for (int i = first; i < argc; ++i) {
+      std::string a = argv[i];
+      if (a.rfind("--", 0) != 0) {
+        bad_ = "unexpected argument '" + a + "'";
+        return;
+      }
+      a = a.substr(2);
+      if (i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0) {
+        values_[a] = argv[++i];
+      } else {
+        values_[a] = "";
+      }
+    }
+  }
+  bool Has(const std::string& key) const {
+    used_.insert(key);
+    return values_.count(key) > 0;
+  }
+  std::string Get(const std::string& key, const std::string& fallback = "") const {
+    used_.insert(key);
+    auto it = values_.find(key);
+    return it == values_.end() ? fallback : it->second;
+  }
+  double GetDouble(const std::string& key, double fallback) const {
+    const std::string v = Get(key);
+    return v.empty() ? fallback : std::atof(v.c_str());
+  }
+  int64_t GetInt(const std::string& key, int64_t fallback) const {
+    const std::string v = Get(key);
+    return v.empty() ? fallback : std::atoll(v.c_str());
+  }
+  // An error message for malformed or unknown arguments, empty if all is well.
+  std::string Problems() const {
+    if (!bad_.empty()) return bad_;
+    for (const auto& kv : values_) {
+      if (!used_.count(kv.first)) return "unknown option --" + kv.first;
+    }
+    return "";
+  }
+
+ private:
+  std::map<std::string, std::string> values_;
+  mutable std::set<std::string> used_;
+  std::string bad_;
+};
+
+int Fail(const std::string& message) {
+  std::cerr << "mbslam-eval: " << message << "\n";
+  return 1;
+}
+
+int Finish(const Json& json, const Args& args) {
+  const bool write_json = args.Has("json");
+  const std::string problems = args.Problems();
+  if (!problems.empty()) return Fail(problems);
+  const std::string text = json.Dump();
+  if (write_json) {
+    const Status st = mbslam::WriteStringAtomically(args.Get("json"), text + "\n");
+    if (!st.ok()) return Fail(st.message());
+  }
+  std::cout << text << std::endl;
+  return 0;
+}
+
+Json StatsJson(const eval::ErrorStats& s) {
+  Json j = Json::Object();
+  j.Set("rmse", s.rmse).Set("mean", s.mean).Set("median", s.median).Set("std", s.std).Set("min", s.min);
+  j.Set("max", s.max).Set("count", s.count);
+  return j;
+}
+
+bool ParseVector3(const std::string& text, Eigen::Vector3d* v) {
+  return std::sscanf(text.c_str(), "%lf,%lf,%lf", &v->x(), &v->y(), &v->z()) == 3;
+}
+
+// ---------------------------------------------------------------- ate
+
+Status LoadGroundTruthCamera(const Args& args, const mbslam::ChannelOptions& channels, eval::Trajectory* gt,
+                             std::string* description) {
+  if (args.Has("gt")) {
+    *description = args.Get("gt");
+    return eval::ReadTumTrajectory(args.Get("gt"), gt);
+  }
+  if (args.Has("gt-log")) {
+    eval::GroundTruthLog log;
+    MBSLAM_RETURN_IF_ERROR(eval::ReadGroundTruthLog(args.Get("gt-log"), args.Get("gt-channel", channels.ground_truth), &log));
+    *gt = log.camera;
+    *description = args.Get("gt-log") + " (" + log.source + ")";
+    return Status::Ok();
+  }
+  if (args.Has("gt-sequence")) {
+    eval::SequenceFolder seq;
+    MBSLAM_RETURN_IF_ERROR(eval::ReadSequenceFolder(args.Get("gt-sequence"), &seq));
+    *gt = seq.camera;
+    *description = args.Get("gt-sequence");
+    return Status::Ok();
+  }
+  if (args.Has("gt-tartanair")) {
+    *description = args.Get("gt-tartanair");
+    return eval::ReadTartanAirPoses(args.Get("gt-tartanair"), args.GetInt("frame-period-us", 1000000), gt);
+  }
+  return Status::Error("ate: give --gt FILE.tum, --gt-log LOG, --gt-sequence DIR or --gt-tartanair pose_left.txt");
+}
+
+int RunAte(const Args& args) {
+  const mbslam::ChannelOptions channels;
+  eval::Trajectory est, gt;
+  std::string gt_description, est_description;
+  int est_messages = -1, est_metric = 0;
+  Status st = LoadGroundTruthCamera(args, channels, &gt, &gt_description);
+  if (!st.ok()) return Fail(st.message());
+  if (args.Has("est")) {
+    est_description = args.Get("est");
+    st = eval::ReadTumTrajectory(args.Get("est"), &est);
+  } else if (args.Has("est-log")) {
+    eval::CameraPoseLog log;
+    est_description = args.Get("est-log");
+    st = eval::ReadCameraPoseLog(args.Get("est-log"), args.Get("est-channel", channels.perception_camera_pose), &log);
+    est = log.tracked;
+    est_messages = log.num_messages;
+    est_metric = log.num_metric;
+  } else {
+    st = Status::Error("ate: give --est FILE.tum or --est-log LOG");
+  }
+  if (!st.ok()) return Fail(st.message());
+
+  eval::AteOptions options;
+  options.alignment = args.Get("align", "sim3");
+  options.max_time_diff_us = args.GetInt("max-dt-us", options.max_time_diff_us);
+  eval::AteResult ate;
+  st = eval::ComputeAte(est, gt, options, &ate);
+  if (!st.ok()) return Fail(st.message());
+  eval::RpeOptions rpe_options;
+  rpe_options.delta_frames = static_cast<int>(args.GetInt("rpe-delta", 1));
+  rpe_options.delta_us = args.GetInt("rpe-delta-us", 0);
+  rpe_options.est_scale = ate.gt_from_est.scale;
+  eval::RpeResult rpe;
+  const Status rpe_status = eval::ComputeRpe(est, gt, ate.pairs, rpe_options, &rpe);
+  const double tracked = eval::FractionTracked(est, gt, options.max_time_diff_us);
+
+  std::printf("ATE of %s against %s\n", est_description.c_str(), gt_description.c_str());
+  std::printf("  poses: %d estimated, %d ground truth, %zu associated (max dt %lld us), fraction tracked %.3f\n",
+              ate.num_est, ate.num_gt, ate.pairs.size(), static_cast<long long>(options.max_time_diff_us), tracked);
+  std::printf("  alignment %s: scale %.6f\n", options.alignment.c_str(), ate.gt_from_est.scale);
+  std::printf("  ATE translation: rmse %.6f m, mean %.6f, median %.6f, max %.6f\n", ate.translation.rmse,
+              ate.translation.mean, ate.translation.median, ate.translation.max);
+  std::printf("  ATE rotation: rmse %.4f deg\n", ate.rotation_deg.rmse);
+  if (rpe_status.ok()) {
+    std::printf("  RPE (delta %s): translation rmse %.6f m, rotation rmse %.4f deg (%d pairs)\n",
+                rpe_options.delta_us > 0 ? (std::to_string(rpe_options.delta_us) + " us").c_str()
+                                         : (std::to_string(rpe_options.delta_frames) + " frames").c_str(),
+                rpe.translation.rmse, rpe.rotation_deg.rmse, rpe.translation.count);
+  } else {
+    std::printf("  RPE: %s\n", rpe_status.message().c_str());
+  }
+  if (args.Has("plot")) {
+    eval::TopViewPlot plot;
+    char title[256];
+    std::snprintf(title, sizeof(title), "%s  ATE %.4f m (%s)", args.Get("title", fs::path(est_description).filename().string()).c_str(),
+                  ate.translation.rmse, options.alignment.c_str());
+    plot.title = title;
+    st = eval::WriteTopView(args.Get("plot"), gt, ate.est_aligned, plot);
+    if (!st.ok()) return Fail(st.message());
+    std::printf("  plot: %s\n", args.Get("plot").c_str());
+  }
+  Json j = Json::Object();
+  j.Set("metric", "ate").Set("alignment", options.alignment);
+  j.Set("ate_rmse_m", ate.translation.rmse).Set("ate_mean_m", ate.translation.mean);
+  j.Set("ate_median_m", ate.translation.median).Set("ate_max_m", ate.translation.max);
+  j.Set("ate_rot_rmse_deg", ate.rotation_deg.rmse).Set("scale", ate.gt_from_est.scale);
+  if (rpe_status.ok()) {
+    j.Set("rpe_trans_rmse_m", rpe.translation.rmse).Set("rpe_rot_rmse_deg", rpe.rotation_deg.rmse);
+    j.Set("rpe_pairs", rpe.translation.count);
+  }
+  j.Set("ate_stats_m", StatsJson(ate.translation));
+  if (rpe_status.ok()) j.Set("rpe_trans_stats_m", StatsJson(rpe.translation));
+  j.Set("num_est", ate.num_est).Set("num_gt", ate.num_gt).Set("num_pairs", ate.pairs.size());
+  j.Set("fraction_tracked", tracked);
+  if (est_messages >= 0) j.Set("est_messages", est_messages).Set("est_metric_messages", est_metric);
+  return Finish(j, args);
+}
+
+// ---------------------------------------------------------------- seg
+
+Status LoadTruthLabels(const std::string& path, std::vector<int>* labels) {
+  const std::string suffix = ".tracks.txt";
+  if (path.size() > suffix.size() && path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0) {
+    eval::TrackSet set;
+    MBSLAM_RETURN_IF_ERROR(eval::ReadTracksFile(path, &set));
+    *labels = set.labels;
+    return Status::Ok();
+  }
+  return eval::ReadLabelFile(path, labels);
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+int RunSeg(const Args& args) {
+  if (args.Has("pred") && args.Has("truth")) {
+    std::vector<int> pred, truth;
+    Status st = eval::ReadLabelFile(args.Get("pred"), &pred);
+    if (st.ok()) st = LoadTruthLabels(args.Get("truth"), &truth);
+    if (!st.ok()) return Fail(st.message());
+    if (pred.size() != truth.size()) {
+      return Fail("seg: " + std::to_string(pred.size()) + " predicted labels for " + std::to_string(truth.size()) +
+                  " points");
+    }
+    const auto r = eval::Misclassification(pred, truth);
+    std::printf("misclassification: %d of %d points wrong = %.4f (%d predicted groups, %d true groups)\n",
+                r.num_errors, r.num_points, r.rate, r.num_pred_groups, r.num_true_groups);
+    Json j = Json::Object();
+    j.Set("metric", "misclassification").Set("rate", r.rate).Set("errors", r.num_errors);
+    j.Set("points", r.num_points).Set("pred_groups", r.num_pred_groups).Set("true_groups", r.num_true_groups);
+    return Finish(j, args);
+  }
+  if (args.Has("pred-dir")) {
+    const std::string tracks_dir = args.Get("tracks-dir", eval::DataSetPath("hopkins155"));
+    if (tracks_dir.empty()) return Fail("seg: no --tracks-dir and no hopkins155 under " + eval::DataRoot());
+    const std::string suffix = args.Get("pred-suffix", ".labels.txt");
+    std::vector<eval::TrackSet> sets;
+    Status st = eval::ReadTracksFolder(tracks_dir, &sets);
+    if (!st.ok()) return Fail(st.message());
+    std::map<int, std::vector<double>> by_groups;
+    std::vector<double> all;
+    int missing = 0;
+    Json per = Json::Object();
+    for (const auto& set : sets) {
+      const std::string pred_path = (fs::path(args.Get("pred-dir")) / (set.name + suffix)).string();
+      std::vector<int> pred;
+      if (!eval::ReadLabelFile(pred_path, &pred).ok() || pred.size() != set.labels.size()) {
+        ++missing;
+        continue;
+      }
+      const auto r = eval::Misclassification(pred, set.labels);
+      by_groups[set.NumGroups()].push_back(r.rate);
+      all.push_back(r.rate);
+      per.Set(set.name, r.rate);
+    }
+    if (all.empty()) return Fail("seg: no usable predictions in " + args.Get("pred-dir"));
+    Json j = Json::Object();
+    j.Set("metric", "misclassification").Set("sequences", all.size()).Set("missing", missing);
+    auto mean = [](const std::vector<double>& v) {
+      double s = 0.0;
+      for (double x : v) s += x;
+      return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+    };
+    for (const auto& g : by_groups) {
+      std::printf("%d groups: %zu sequences, mean %.4f, median %.4f\n", g.first, g.second.size(), mean(g.second),
+                  Median(g.second));
+      j.Set(std::to_string(g.first) + "_groups_mean", mean(g.second));
+      j.Set(std::to_string(g.first) + "_groups_median", Median(g.second));
+    }
+    std::printf("all: %zu sequences, mean %.4f, median %.4f (%d without predictions)\n", all.size(), mean(all),
+                Median(all), missing);
+    j.Set("all_mean", mean(all)).Set("all_median", Median(all)).Set("per_sequence", per);
+    return Finish(j, args);
+  }
+  return Fail("seg: give --pred FILE --truth FILE, or --pred-dir DIR [--tracks-dir DIR]");
+}
+
+// ---------------------------------------------------------------- masks
+
+int RunMasks(const Args& args) {
+  const std::string pred_dir = args.Get("pred-dir"), gt_dir = args.Get("gt-dir");
+  if (pred_dir.empty() || gt_dir.empty()) return Fail("masks: give --pred-dir DIR --gt-dir DIR");
+  // Features "frame_stem u v moving(0/1)" per line, optional.
+  std::map<std::string, std::vector<eval::LabelledFeature>> features;
+  if (args.Has("features")) {
+    std::string text;
+    Status st = mbslam::ReadFileToString(args.Get("features"), &text);
+    if (!st.ok()) return Fail(st.message());
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream ls(line);
+      std::string stem;
+      eval::LabelledFeature f;
+      int moving = 0;
+      if (!(ls >> stem >> f.u >> f.v >> moving)) return Fail("masks: bad feature line '" + line + "'");
+      f.moving = moving != 0;
+      features[stem].push_back(f);
+    }
+  }
+  std::vector<std::string> gt_files;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(gt_dir, ec)) {
+    if (e.path().extension() == ".png") gt_files.push_back(e.path().string());
+  }
+  std::sort(gt_files.begin(), gt_files.end());
+  if (gt_files.empty()) return Fail("masks: no *.png in " + gt_dir);
+  std::vector<double> ious;
+  eval::PrecisionRecall total;
+  int missing = 0;
+  for (const auto& g : gt_files) {
+    const std::string stem = fs::path(g).stem().string();
+    cv::Mat truth, pred;
+    Status st = eval::LoadBinaryMask(g, &truth);
+    if (!st.ok()) return Fail(st.message());
+    const std::string pred_path = (fs::path(pred_dir) / (stem + ".png")).string();
+    if (!eval::LoadBinaryMask(pred_path, &pred).ok()) {
+      ++missing;
+      continue;
+    }
+    if (pred.size() != truth.size()) return Fail("masks: size differs for " + stem);
+    ious.push_back(eval::RegionIoU(pred, truth));
+    auto it = features.find(stem);
+    if (it != features.end()) total.Add(eval::MovingFeaturePrecisionRecall(it->second, truth));
+  }
+  if (ious.empty()) return Fail("masks: no predicted mask matches a ground-truth file name");
+  double sum = 0.0;
+  for (double v : ious) sum += v;
+  const double mean = sum / static_cast<double>(ious.size());
+  std::printf("region IoU over %zu frames: mean %.4f, median %.4f (%d frames without prediction)\n", ious.size(), mean,
+              Median(ious), missing);
+  Json j = Json::Object();
+  j.Set("metric", "masks").Set("frames", ious.size()).Set("missing", missing).Set("iou_mean", mean);
+  j.Set("iou_median", Median(ious));
+  if (!features.empty()) {
+    std::printf("moving features: precision %.4f, recall %.4f (TP %d, FP %d, FN %d)\n", total.precision, total.recall,
+                total.true_positives, total.false_positives, total.false_negatives);
+    j.Set("precision", total.precision).Set("recall", total.recall).Set("f1", total.f1);
+  }
+  return Finish(j, args);
+}
+
+// ---------------------------------------------------------------- objects
+
+int RunObjects(const Args& args) {
+  const mbslam::ChannelOptions channels;
+  if (!args.Has("est-log") || !args.Has("gt-log")) return Fail("objects: give --est-log LOG --gt-log LOG");
+  eval::GroundTruthLog gt;
+  Status st = eval::ReadGroundTruthLog(args.Get("gt-log"), args.Get("gt-channel", channels.ground_truth), &gt);
+  if (!st.ok()) return Fail(st.message());
+  std::map<int, eval::ObjectEstimate> objects;
+  int messages = 0;
+  st = eval::ReadObjectsLog(args.Get("est-log"), args.Get("objects-channel", channels.perception_objects), &objects,
+                            &messages);
+  if (!st.ok()) return Fail(st.message());
+  // The estimate's world frame, from the camera trajectories.
+  eval::CameraPoseLog cam;
+  st = eval::ReadCameraPoseLog(args.Get("est-log"), args.Get("est-channel", channels.perception_camera_pose), &cam);
+  if (!st.ok()) return Fail(st.message());
+  eval::AteOptions ate_options;
+  ate_options.alignment = args.Get("align", "sim3");
+  eval::AteResult ate;
+  st = eval::ComputeAte(cam.tracked, gt.camera, ate_options, &ate);
+  if (!st.ok()) return Fail("objects: cannot align the estimate's world frame: " + st.message());
+  eval::ObjectMetricsOptions options;
+  options.horizon_us = args.GetInt("horizon-us", options.horizon_us);
+  options.max_match_distance = args.GetDouble("max-match-m", options.max_match_distance);
+  eval::ObjectsEvaluation result;
+  st = eval::EvaluateObjects(objects, gt.bodies, gt.camera, ate.gt_from_est, options, &result);
+  if (!st.ok()) return Fail(st.message());
+  std::printf("objects: %d estimated, %d true bodies, %zu matched, %d unmatched estimates (camera ATE %.4f m)\n",
+              result.num_est_objects, result.num_gt_bodies, result.objects.size(), result.unmatched_est,
+              ate.translation.rmse);
+  Json list = Json::Array();
+  for (const auto& o : result.objects) {
+    std::printf("  est %d -> body %d (%s): %d samples, error %.3f m, scale-aligned %.3f m, scale %.3f, depth error "
+                "%.3f m, volumes %d/%d inside\n",
+                o.est_id, o.gt_id, o.gt_name.c_str(), o.num_samples, o.position_error.rmse,
+                o.position_error_scaled.rmse, o.best_scale, o.depth_error.rmse, o.volumes_hit, o.volumes_checked);
+    Json oj = Json::Object();
+    oj.Set("est_id", o.est_id).Set("gt_id", o.gt_id).Set("name", o.gt_name).Set("samples", o.num_samples);
+    oj.Set("position_rmse_m", o.position_error.rmse).Set("position_scaled_rmse_m", o.position_error_scaled.rmse);
+    oj.Set("best_scale", o.best_scale).Set("relative_scale_error", o.relative_scale_error);
+    oj.Set("depth_rmse_m", o.depth_error.rmse).Set("volume_hit_rate", o.hit_rate);
+    Json series = Json::Array();
+    for (const auto& d : o.depth_error_over_time) series.Push(d.second);
+    oj.Set("depth_error_over_time_m", series);
+    list.Push(oj);
+  }
+  std::printf("predicted volumes at %lld us: %d of %d contain the true centre (%.3f)\n",
+              static_cast<long long>(options.horizon_us), result.volumes_hit, result.volumes_checked, result.hit_rate);
+  Json j = Json::Object();
+  j.Set("metric", "objects").Set("est_objects", result.num_est_objects).Set("gt_bodies", result.num_gt_bodies);
+  j.Set("matched", result.objects.size()).Set("unmatched_est", result.unmatched_est);
+  j.Set("volume_hit_rate", result.hit_rate).Set("volumes_checked", result.volumes_checked);
+  j.Set("camera_ate_rmse_m", ate.translation.rmse).Set("objects", list);
+  return Finish(j, args);
+}
+
+// ---------------------------------------------------------------- perturb
+
+int RunPerturb(const Args& args) {
+  if (!args.Has("in") || !args.Has("out")) return Fail("perturb: give --in GT.tum --out EST.tum");
+  eval::Trajectory gt, est;
+  Status st = eval::ReadTumTrajectory(args.Get("in"), &gt);
+  if (!st.ok()) return Fail(st.message());
+  eval::TrajectoryPerturbation p;
+  p.gt_from_est.scale = args.GetDouble("scale", 1.0);
+  Eigen::Vector3d axis(0.0, 0.0, 1.0), trans = Eigen::Vector3d::Zero();
+  if (args.Has("axis") && !ParseVector3(args.Get("axis"), &axis)) return Fail("perturb: --axis wants x,y,z");
+  if (args.Has("trans") && !ParseVector3(args.Get("trans"), &trans)) return Fail("perturb: --trans wants x,y,z");
+  if (axis.norm() == 0.0 || !(p.gt_from_est.scale > 0.0)) return Fail("perturb: bad axis or scale");
+  p.gt_from_est.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(args.GetDouble("rot-deg", 0.0) * M_PI / 180.0, axis.normalized()));
+  p.gt_from_est.translation = trans;
+  p.noise_sigma_m = args.GetDouble("noise", 0.0);
+  p.seed = static_cast<uint64_t>(args.GetInt("seed", 1));
+  p.exact = !args.Has("no-exact");
+  double expected = 0.0;
+  st = eval::PerturbTrajectory(gt, p, &est, &expected);
+  if (st.ok()) st = eval::WriteTumTrajectory(args.Get("out"), est, "perturbed copy of " + args.Get("in"));
+  if (!st.ok()) return Fail(st.message());
+  std::printf("wrote %zu poses to %s: est = S^-1 (gt + n), scale %.6f, noise rms %.6f m%s\n", est.size(),
+              args.Get("out").c_str(), p.gt_from_est.scale, expected, p.exact ? " (exact)" : "");
+  Json j = Json::Object();
+  j.Set("metric", "perturb").Set("poses", est.size()).Set("scale", p.gt_from_est.scale);
+  j.Set("expected_ate_sim3_m", expected).Set("exact", p.exact);
+  return Finish(j, args);
+}
+
+int RunPerturbLabels(const Args& args) {
+  if (!args.Has("truth") || !args.Has("out")) return Fail("perturb-labels: give --truth FILE --out FILE");
+  std::vector<int> truth, pred;
+  Status st = LoadTruthLabels(args.Get("truth"), &truth);
+  if (!st.ok()) return Fail(st.message());
+  eval::LabelPerturbation p;
+  p.wrong = static_cast<int>(args.GetInt("wrong", 0));
+  p.split = static_cast<int>(args.GetInt("split", 0));
+  p.merge_smallest = args.Has("merge");
+  p.permute = !args.Has("no-permute");
+  p.seed = static_cast<uint64_t>(args.GetInt("seed", 1));
+  int expected = 0;
+  st = eval::PerturbLabels(truth, p, &pred, &expected);
+  if (st.ok()) st = eval::WriteLabelFile(args.Get("out"), pred);
+  if (!st.ok()) return Fail(st.message());
+  const double rate = truth.empty() ? 0.0 : static_cast<double>(expected) / static_cast<double>(truth.size());
+  std::printf("wrote %zu labels to %s with %d known errors (rate %.6f)\n", pred.size(), args.Get("out").c_str(),
+              expected, rate);
+  Json j = Json::Object();
+  j.Set("metric", "perturb-labels").Set("points", truth.size()).Set("expected_errors", expected);
+  j.Set("expected_rate", rate);
+  return Finish(j, args);
+}
+
+// ---------------------------------------------------------------- datasets
+
+int RunDatasets(const Args& args) {
+  Json j = Json::Object();
+  j.Set("metric", "datasets").Set("root", eval::DataRoot());
+  std::printf("data root: %s\n", eval::DataRoot().c_str());
+  auto report = [&](const std::string& name, const std::string& text, Json info) {
+    std::printf("  %-26s %s\n", name.c_str(), text.c_str());
+    j.Set(name, info);
+  };
+  if (const std::string p = eval::DataSetPath("hopkins155"); !p.empty()) {
+    std::vector<eval::TrackSet> sets;
+    const Status st = eval::ReadTracksFolder(p, &sets);
+    if (!st.ok()) return Fail(st.message());
+    std::map<int, int> by_groups;
+    for (const auto& s : sets) ++by_groups[s.NumGroups()];
+    std::string text = std::to_string(sets.size()) + " sequences (";
+    Json info = Json::Object();
+    info.Set("sequences", sets.size());
+    for (const auto& g : by_groups) {
+      text += std::to_string(g.second) + " with " + std::to_string(g.first) + " groups, ";
+      info.Set(std::to_string(g.first) + "_groups", g.second);
+    }
+    report("hopkins155", text + ")", info);
+  }
+  if (const std::string p = eval::DataSetPath("davis2016"); !p.empty()) {
+    std::vector<eval::DavisSequence> seqs;
+    const Status st = eval::ReadDavis(p, &seqs);
+    if (!st.ok()) return Fail(st.message());
+    size_t frames = 0;
+    for (const auto& s : seqs) frames += s.masks.size();
+    report("davis2016", std::to_string(seqs.size()) + " sequences, " + std::to_string(frames) + " masked frames",
+           Json::Object().Set("sequences", seqs.size()).Set("frames", frames));
+  }
+  if (const std::string p = eval::DataSetPath("camvid_0016E5_15hz"); !p.empty()) {
+    std::vector<eval::CamVidFrame> frames;
+    const Status st = eval::ReadCamVid(p, &frames);
+    if (!st.ok()) return Fail(st.message());
+    report("camvid_0016E5_15hz", std::to_string(frames.size()) + " labelled frames",
+           Json::Object().Set("frames", frames.size()));
+  }
+  if (const std::string p = eval::DataSetPath("tum_fr3_cabinet_subset"); !p.empty()) {
+    eval::TumSubset tum;
+    const Status st = eval::ReadTumSubset(p, &tum);
+    if (!st.ok()) return Fail(st.message());
+    report("tum_fr3_cabinet_subset", std::to_string(tum.truth.size()) + " poses and images",
+           Json::Object().Set("frames", tum.truth.size()));
+  }
+  if (const std::string p = eval::DataSetPath("tartanair_indoor_subset"); !p.empty()) {
+    eval::TartanAirSubset ta;
+    const Status st = eval::ReadTartanAirSubset(p, 1000000, &ta);
+    if (!st.ok()) return Fail(st.message());
+    double length = 0.0;
+    for (size_t i = 1; i < ta.truth.size(); ++i) {
+      length += (ta.truth[i].pose.translation - ta.truth[i - 1].pose.translation).norm();
+    }
+    report("tartanair_indoor_subset",
+           std::to_string(ta.truth.size()) + " poses and images, path " + std::to_string(length) + " m",
+           Json::Object().Set("frames", ta.truth.size()).Set("path_length_m", length));
+  }
+  return Finish(j, args);
+}
+
+void Usage() {
+  std::cerr << R"(usage: mbslam-eval SUBCOMMAND [--options]
+  ate      camera trajectory: ATE (Sim(3)/SE(3)/no alignment), RPE, fraction tracked
+           --est F.tum | --est-log LOG [--est-channel C]
+           --gt F.tum | --gt-log LOG [--gt-channel C] | --gt-sequence DIR | --gt-tartanair pose_left.txt
+           [--align sim3|se3|none] [--max-dt-us N] [--rpe-delta N | --rpe-delta-us N] [--plot OUT.png] [--title T]
+  seg      track misclassification (Hungarian matching)
+           --pred LABELS --truth LABELS|X.tracks.txt
+           --pred-dir DIR [--tracks-dir DIR (default: Hopkins 155)] [--pred-suffix .labels.txt]
+  masks    region IoU and moving-feature precision / recall
+           --pred-dir DIR --gt-dir DIR [--features FILE ("stem u v moving" per line)]
+  objects  per-object trajectory / scale / depth errors and predicted-volume hit rate
+           --est-log LOG --gt-log LOG [--horizon-us N] [--align sim3|se3] [--max-match-m M]
+  perturb  write a trajectory with a known similarity and noise (expected ATE printed)
+           --in GT.tum --out EST.tum [--scale S] [--rot-deg A] [--axis x,y,z] [--trans x,y,z] [--noise M] [--seed N] [--no-exact]
+  perturb-labels  write labels with a known number of errors
+           --truth LABELS|X.tracks.txt --out FILE [--wrong K] [--split M] [--merge] [--no-permute] [--seed N]
+  datasets what of ../shared/data ($MBSLAM_DATA) is present
+every subcommand accepts --json FILE and prints one JSON object as its last line.
+)";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
+    Usage();
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string cmd = argv[1];
+  const Args args(argc, argv, 2);
+  if (cmd == "ate") return RunAte(args);
+  if (cmd == "seg") return RunSeg(args);
+  if (cmd == "masks") return RunMasks(args);
+  if (cmd == "objects") return RunObjects(args);
+  if (cmd == "perturb") return RunPerturb(args);
+  if (cmd == "perturb-labels") return RunPerturbLabels(args);
+  if (cmd == "datasets") return RunDatasets(args);
+  std::cerr << "mbslam-eval: unknown subcommand '" << cmd << "'\n";
+  Usage();
+  return 2;
+}

@@ -1,0 +1,170 @@
+#include "tools/eval/object_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "tools/eval/hungarian.h"
+
+namespace mbslam {
+namespace eval {
+
+bool PredictedVolume::Contains(const Eigen::Vector3d& point) const {
+  const Eigen::Vector3d local = orientation.conjugate() * (point - center);
+  return (local.cwiseAbs().array() <= half_extent.array()).all();
+}
+
+bool InterpolatePose(const Trajectory& poses, int64_t utime, int64_t max_gap_us, Rigid3d* pose) {
+  if (poses.empty()) return false;
+  auto it = std::lower_bound(poses.begin(), poses.end(), utime,
+                             [](const TimedPose& p, int64_t t) { return p.utime < t; });
+  if (it != poses.end() && it->utime == utime) {
+    *pose = it->pose;
+    return true;
+  }
+  if (it == poses.begin() || it == poses.end()) return false;
+  const TimedPose& b = *it;
+  const TimedPose& a = *std::prev(it);
+  if (b.utime - a.utime > max_gap_us) return false;
+  *pose = Rigid3d::Interpolate(a.pose, b.pose,
+                               static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime));
+  return true;
+}
+
+namespace {
+
+// Truth at the time of an estimate sample: nearest ground-truth sample within the
+// tolerance (ground truth is per image, estimates are per image too).
+bool TruthAt(const Trajectory& poses, int64_t utime, int64_t tolerance, Rigid3d* pose) {
+  auto it = std::lower_bound(poses.begin(), poses.end(), utime,
+                             [](const TimedPose& p, int64_t t) { return p.utime < t; });
+  int64_t best = std::numeric_limits<int64_t>::max();
+  for (auto jt : {it, it == poses.begin() ? poses.end() : std::prev(it)}) {
+    if (jt == poses.end()) continue;
+    const int64_t dt = std::llabs(jt->utime - utime);
+    if (dt <= tolerance && dt < best) {
+      best = dt;
+      *pose = jt->pose;
+    }
+  }
+  return best != std::numeric_limits<int64_t>::max();
+}
+
+struct Common {
+  int64_t utime;
+  Eigen::Vector3d est;     // estimate mapped into the truth world
+  Eigen::Vector3d truth;   // body centre
+  Eigen::Vector3d camera;  // camera centre
+  Rigid3d cam_from_world;
+  double est_depth;        // < 0 if not given (truth units)
+  const ObjectSample* sample;
+};
+
+std::vector<Common> CommonSamples(const ObjectEstimate& est, const BodyTruth& body, const Trajectory& gt_camera,
+                                  const Sim3d& gt_from_est, int64_t tolerance) {
+  std::vector<Common> out;
+  for (const auto& s : est.samples) {
+    Rigid3d body_pose, cam_pose;
+    if (!TruthAt(body.poses, s.utime, tolerance, &body_pose) || !TruthAt(gt_camera, s.utime, tolerance, &cam_pose)) {
+      continue;
+    }
+    Common c;
+    c.utime = s.utime;
+    c.est = gt_from_est * s.position;
+    c.truth = body_pose.translation;
+    c.camera = cam_pose.translation;
+    c.cam_from_world = cam_pose.Inverse();
+    c.est_depth = s.depth >= 0.0 ? s.depth * gt_from_est.scale : -1.0;
+    c.sample = &s;
+    out.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace
+
+Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates, const std::map<int, BodyTruth>& truth,
+                       const Trajectory& gt_camera, const Sim3d& gt_from_est, const ObjectMetricsOptions& options,
+                       ObjectsEvaluation* result) {
+  if (!options.Check()) return Status::Error("object metrics options: " + LastOptionError());
+  *result = ObjectsEvaluation();
+  result->num_est_objects = static_cast<int>(estimates.size());
+  result->num_gt_bodies = static_cast<int>(truth.size());
+  std::vector<const ObjectEstimate*> est_list;
+  std::vector<const BodyTruth*> gt_list;
+  for (const auto& e : estimates) est_list.push_back(&e.second);
+  for (const auto& t : truth) gt_list.push_back(&t.second);
+  // Association: mean distance over common samples, gated, Hungarian.
+  const double kForbidden = 1e9;
+  Eigen::MatrixXd cost = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(est_list.size()),
+                                                   static_cast<Eigen::Index>(gt_list.size()), kForbidden);
+  for (size_t i = 0; i < est_list.size(); ++i) {
+    for (size_t j = 0; j < gt_list.size(); ++j) {
+      const auto common = CommonSamples(*est_list[i], *gt_list[j], gt_camera, gt_from_est, options.max_time_diff_us);
+      if (static_cast<int>(common.size()) < options.min_samples) continue;
+      double sum = 0.0;
+      for (const auto& c : common) sum += (c.est - c.truth).norm();
+      const double mean = sum / static_cast<double>(common.size());
+      if (mean <= options.max_match_distance) {
+        cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = mean;
+      }
+    }
+  }
+  const std::vector<int> assignment = SolveAssignment(cost);
+  for (size_t i = 0; i < est_list.size(); ++i) {
+    const int j = assignment[i];
+    if (j < 0 || cost(static_cast<Eigen::Index>(i), j) >= kForbidden) {
+      ++result->unmatched_est;
+      continue;
+    }
+    const ObjectEstimate& est = *est_list[i];
+    const BodyTruth& body = *gt_list[static_cast<size_t>(j)];
+    const auto common = CommonSamples(est, body, gt_camera, gt_from_est, options.max_time_diff_us);
+    ObjectResult r;
+    r.est_id = est.id;
+    r.gt_id = body.id;
+    r.gt_name = body.name;
+    r.num_samples = static_cast<int>(common.size());
+    // Best scale about the camera: minimise sum |c + s (p - c) - g|^2.
+    double num = 0.0, den = 0.0;
+    for (const auto& c : common) {
+      num += (c.est - c.camera).dot(c.truth - c.camera);
+      den += (c.est - c.camera).squaredNorm();
+    }
+    r.best_scale = den > 0.0 ? num / den : 1.0;
+    r.relative_scale_error = std::abs(r.best_scale - 1.0);
+    std::vector<double> plain, scaled, depth;
+    for (const auto& c : common) {
+      plain.push_back((c.est - c.truth).norm());
+      scaled.push_back((c.camera + r.best_scale * (c.est - c.camera) - c.truth).norm());
+      const double true_depth = (c.cam_from_world * c.truth).z();
+      const double est_depth = c.est_depth >= 0.0 ? c.est_depth : (c.cam_from_world * c.est).z();
+      depth.push_back(std::abs(est_depth - true_depth));
+      r.depth_error_over_time.emplace_back(c.utime, est_depth - true_depth);
+    }
+    r.position_error = ErrorStats::From(plain);
+    r.position_error_scaled = ErrorStats::From(scaled);
+    r.depth_error = ErrorStats::From(depth);
+    // Predicted volumes at the horizon: does the true centre lie inside the box?
+    const Sim3d est_from_gt = gt_from_est.Inverse();
+    for (const auto& s : est.samples) {
+      for (const auto& v : s.volumes) {
+        if (std::llabs(v.horizon_us - options.horizon_us) > options.horizon_tolerance_us) continue;
+        Rigid3d body_pose;
+        if (!InterpolatePose(body.poses, v.utime, 1000000, &body_pose)) continue;  // beyond the truth
+        ++r.volumes_checked;
+        if (v.Contains(est_from_gt * body_pose.translation)) ++r.volumes_hit;
+      }
+    }
+    r.hit_rate = r.volumes_checked > 0 ? static_cast<double>(r.volumes_hit) / r.volumes_checked : 0.0;
+    result->volumes_checked += r.volumes_checked;
+    result->volumes_hit += r.volumes_hit;
+    result->objects.push_back(r);
+  }
+  result->hit_rate =
+      result->volumes_checked > 0 ? static_cast<double>(result->volumes_hit) / result->volumes_checked : 0.0;
+  return Status::Ok();
+}
+
+}  // namespace eval
+}  // namespace mbslam
