@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "common/util/logging.h"
+#include "common/util/shutdown.h"
 #include "common/util/time.h"
 #include "drivers/camera/image_codec.h"
 
@@ -144,6 +145,7 @@ FrameSource::ReadResult V4l2Source::Next(Frame* frame, SourceStatus* status) {
     ok = false;
   }
   const int64_t now = WallUtime();
+  if ((!ok || image.empty()) && ShutdownRequested()) return ReadResult::kEnd;  // EINTR from SIGINT
   if (!ok || image.empty()) {
     std::error_code ec;
     const bool gone = !std::filesystem::exists(device_, ec);

@@ -11,6 +11,7 @@
 
 #include "common/lcm/lcm_log.h"
 #include "common/lcm/wire_check.h"
+#include "common/util/time.h"
 #include "drivers/camera/camera_messages.h"
 #include "drivers/camera/camera_test_util.h"
 #include "drivers/common/exit_codes.h"
@@ -291,6 +292,23 @@ TEST(CameraDriverLog, BadInputsGiveDistinctCodes) {
   EXPECT_EQ(r.exit_code, kExitOk);
   EXPECT_NE(r.err.find("2 bad frames skipped"), std::string::npos) << r.err;
   EXPECT_EQ(ReadLog(dir + "/d.lcmlog").images.size(), 1u);
+}
+
+TEST(CameraDriverLog, SigtermDuringPacedPlaybackExitsCleanly) {
+  const std::string dir = MakeTempDir("it_sigterm");
+  for (int i = 0; i < 20; ++i) cv::imwrite(dir + "/" + std::to_string(i) + ".png", MakeTestImage(8, 8, 1, i));
+  // 2 Hz at recorded speed: 10 s of playback, on an in-process bus (no network).
+  testing_util::ChildProcess driver({BinPath("camera_driver"), "--quiet", "--no-progress", "--input", dir,
+                                     "--rate", "2", "--speed", "1", "--lcm-url", "memq://"});
+  usleep(700000);
+  const int64_t start = MonotonicUtime();
+  driver.Signal(SIGTERM);
+  const auto r = driver.Wait(5.0);
+  EXPECT_EQ(r.exit_code, kExitOk) << r.err;
+  EXPECT_LT(MonotonicUtime() - start, 1000000);
+  // Stopped part-way: some of the 20 frames, not all (timing decides how many).
+  EXPECT_NE(r.err.find("published "), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("published 20 frames"), std::string::npos) << r.err;
 }
 
 std::string SharedData(const std::string& sub) {

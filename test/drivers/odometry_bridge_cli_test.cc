@@ -149,6 +149,17 @@ TEST(OdometryBridgeCli, FileInputsAndExitCodes) {
       << r.err;
 }
 
+TEST(OdometryBridgeCli, SigintStopsALiveBridgeCleanly) {
+  const std::string dir = MakeTempDir("it_sigint");
+  ChildProcess bridge({BinPath("odometry_bridge"), "--quiet", "--domain", std::to_string(UniqueDomain(4)), "--log",
+                       dir + "/o.lcmlog"});
+  usleep(500000);
+  bridge.Signal(SIGINT);
+  const auto r = bridge.Wait(5.0);
+  EXPECT_EQ(r.exit_code, kExitOk) << r.err;
+  EXPECT_NE(r.err.find("published 0 odometry messages"), std::string::npos) << r.err;
+}
+
 TEST(HandEyeCli, RecoversTheExtrinsicAndWritesItForTheBridge) {
   // A planar robot driving curves; the camera trajectory is up to scale (0.5 m per unit).
   const Rigid3d truth(Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5) *

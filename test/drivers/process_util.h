@@ -75,6 +75,8 @@ class ChildProcess {
     if (!waited_) Wait(0.0);
   }
 
+  void Signal(int signal_number) { kill(pid_, signal_number); }
+
   // Waits up to timeout_s, then kills it (exit_code -1 then).
   ProcessResult Wait(double timeout_s) {
     ProcessResult result;
