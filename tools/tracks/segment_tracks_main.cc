@@ -127,7 +127,9 @@ int Run(int argc, char** argv) {
     return 1;
   }
 
-  const SegmentationOptions seg_options;
+  // Short near-affine track sequences: the multi-view multibody initialisation applies.
+  SegmentationOptions seg_options;
+  seg_options.multibody_init = true;
   const bool do_known = mode != "online", do_online = mode != "known_k";
   std::map<std::string, std::vector<double>> known, online;  // "2", "3", "all"
   int online_k_right = 0, sequences = 0;

@@ -92,6 +92,9 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   result.camera_pose.tracking_state = TrackingState::kNotInitialized;
   {
     ScopedStageTimer timer(preprocess_timer_);
+    // A fresh pyramid every image: the tracker keeps the previous one (shallow Mats),
+    // so buffers must not be reused.
+    pyramid_ = std::vector<cv::Mat>();
     cv::buildOpticalFlowPyramid(frame.gray, pyramid_, cv::Size(21, 21),
                                 options_.preprocess.pyramid_levels - 1);
   }
@@ -134,6 +137,14 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       };
     }
     seg = segmenter_.Update(in);
+  }
+  if (GetLogLevel() <= LogLevel::kDebug) {
+    int moving = 0;
+    for (const TrackLabel& l : seg.labels) moving += l.body_id != 0;
+    MBSLAM_LOG(DEBUG) << "frame " << frame_index_ << ": tracks " << seg.labels.size() << " moving "
+                      << moving << " objects " << seg.objects.size() << " world motion "
+                      << (seg.world_motion ? (seg.world_motion->translation_known ? "R,t" : "R only") : "none")
+                      << " ref " << seg.world_ref_frame;
   }
 
   // Labels back onto the tracks (feedback to the tracker's occlusion handling).

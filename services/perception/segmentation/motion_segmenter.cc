@@ -102,7 +102,7 @@ std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput&
     if (!t.At(ref, &x)) continue;
     xr_all.push_back(x);
     xn_all.push_back(o.xy);
-    if (!t.moving && t.object == 0) {
+    if (t.p_static >= options_.world_min_p_static) {
       xr.push_back(x);
       xn.push_back(o.xy);
     }

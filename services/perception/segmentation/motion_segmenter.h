@@ -33,7 +33,7 @@ struct SegmentationOptions {
   StaticLikelihoodOptions likelihood;
   TwoViewOptions two_view;
   SubspaceClusteringOptions multibody;  // multi-view multibody initialisation (sec. 3.4)
-  bool multibody_init = true;       // (re)initialise the bodies by subspace clustering of the track window
+  bool multibody_init = false;      // (re)initialise bodies by affine subspace clustering of the track window (near-affine views, e.g. Hopkins; not for forward motion)
   int multibody_min_frames = 10;    // window length needed for the first initialisation (frames)
   int multibody_max_frames = 30;    // longest window used (frames)
   int multibody_every_frames = 10;  // re-initialisation period (frames); 0 = only once
@@ -59,6 +59,8 @@ struct SegmentationOptions {
   double distance_std_rel = 0.05;   // ... plus this fraction of the distance
   int min_model_tracks = 10;        // an object gets its own motion model above this (count)
   int world_min_tracks = 15;        // static tracks needed to estimate the world motion (count)
+  double world_min_p_static = 0.25; // tracks at least this likely static take part in the world-motion RANSAC
+                                    // (below the moving threshold, so mislabelled static tracks can come back)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(likelihood);
@@ -116,6 +118,7 @@ struct SegmentationOptions {
     v("distance_std_rel", &distance_std_rel, "allowed std of pair distances (fraction)");
     v("min_model_tracks", &min_model_tracks, "tracks for an object's own motion model (count)");
     v("world_min_tracks", &world_min_tracks, "static tracks to estimate the world motion (count)");
+    v("world_min_p_static", &world_min_p_static, "P(static) for taking part in the world-motion RANSAC");
   }
 };
 

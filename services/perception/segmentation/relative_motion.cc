@@ -7,6 +7,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
+#include "common/util/logging.h"
+
 namespace mbslam {
 
 double EpipolarDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& x_r,
@@ -190,27 +192,29 @@ Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
     const double med = sorted[sorted.size() / 2];
     for (size_t i = 0; i < n; ++i) rot_inlier[i] = residual[i] <= std::max(3.0 * med, options.ransac_threshold_px);
   }
-  std::vector<double> inl_res;
-  for (size_t i = 0; i < n; ++i) {
-    if (rot_inlier[i]) inl_res.push_back(residual[i]);
-  }
-  std::nth_element(inl_res.begin(), inl_res.begin() + inl_res.size() / 2, inl_res.end());
-  const double median_parallax = inl_res.empty() ? 0.0 : inl_res[inl_res.size() / 2];
-  if (median_parallax < options.min_parallax_px) {
+  // Inliers of the rotation-only model at the RANSAC threshold (full 2D residual).
+  int rot_count = 0;
+  for (size_t i = 0; i < n; ++i) rot_count += residual[i] <= options.ransac_threshold_px;
+  std::vector<double> all_res = residual;
+  std::nth_element(all_res.begin(), all_res.begin() + all_res.size() / 2, all_res.end());
+  const double median_parallax = all_res[all_res.size() / 2];
+  auto rotation_only = [&]() {
     motion->cam_n_from_cam_r = Rigid3d(Eigen::Matrix3d(R_rot), Eigen::Vector3d::Zero());
     motion->translation_known = false;
     motion->scale_known = false;
     motion->source = RelativeMotion::Source::kTwoView;
-    *inliers = rot_inlier;
+    inliers->assign(n, 0);
+    for (size_t i = 0; i < n; ++i) (*inliers)[i] = residual[i] <= options.ransac_threshold_px;
     // Each inlier constrains the rotation through its 2D residual, about one radian
     // per focal length: var(r) ~ sigma^2 / (N f^2) per axis.
-    int count = 0;
-    for (uint8_t v : rot_inlier) count += v;
-    const double var = std::pow(options.sigma_px / focal_px, 2) / std::max(1, count);
+    const double var = std::pow(options.sigma_px / focal_px, 2) / std::max(1, rot_count);
     motion->covariance = Matrix6d::Zero();
     motion->covariance.bottomRightCorner<3, 3>() = var * Eigen::Matrix3d::Identity();
     return Status::Ok();
-  }
+  };
+  MBSLAM_LOG(DEBUG) << "two-view: n " << n << " median parallax " << median_parallax << " px, rotation inliers "
+                    << rot_count;
+  if (median_parallax < options.min_parallax_px) return rotation_only();
 
   cv::Mat mask;
   cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC,
@@ -236,6 +240,12 @@ Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
   for (size_t i = 0; i < n; ++i) {
     (*inliers)[i] = std::abs(EpipolarDistance(Em, x_r[i], x_n[i])) <= thresh ? 1 : 0;
   }
+  // A pure rotation satisfies every epipolar constraint: prefer the simpler model when
+  // it explains (nearly) as many points.
+  int e_count = 0;
+  for (uint8_t v : *inliers) e_count += v;
+  MBSLAM_LOG(DEBUG) << "two-view: essential inliers " << e_count << " t " << T.translation.transpose();
+  if (rot_count >= 0.95 * e_count) return rotation_only();
   motion->cam_n_from_cam_r = T;
   motion->translation_known = true;
   motion->scale_known = false;

@@ -43,7 +43,7 @@ struct TwoViewOptions {
   double sigma_px = 0.8;           // feature position noise (px)
   double ransac_threshold_px = 1.5;  // inlier threshold on the epipolar distance (px)
   double ransac_confidence = 0.999;  // RANSAC confidence
-  double min_parallax_px = 1.0;    // median rotation-compensated flow below this = pure rotation (px)
+  double min_parallax_px = 1.0;    // median rotation-compensated flow below this = pure rotation, no essential fit (px)
   int min_points = 12;             // fewer correspondences: no estimate (count)
 
   bool Check() const {

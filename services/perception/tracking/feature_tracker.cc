@@ -49,33 +49,34 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   std::vector<cv::Point2f> prev_pts, next_pts;
   std::vector<std::pair<size_t, Eigen::Vector2f>> reappearing;  // occluded, predicted visible
 
-  // Occlusion and predictions.
+  // Predictions. Tracks already occluded stay so while their predicted position is
+  // inside a hull of another body; outside, they are re-detected on their template.
+  std::vector<Eigen::Vector2f> predicted(tracks_.size());
+  auto inside_other_hull = [&hints](const Track& t, const Eigen::Vector2f& p) {
+    for (const TrackingHints::Hull& h : hints.occluders) {
+      if (h.body_id != t.body_id && InsideConvexHull(h.points, p)) return true;
+    }
+    return false;
+  };
   for (size_t i = 0; i < tracks_.size(); ++i) {
     Track& t = tracks_[i];
     t.is_new = false;
     auto it = hints.predicted_uv.find(t.id);
     const Eigen::Vector2f pred =
         it != hints.predicted_uv.end() ? it->second : Eigen::Vector2f(t.uv + t.velocity);
+    predicted[i] = pred;
     if (!pred.allFinite()) continue;
-    bool occluded = false;
-    for (const TrackingHints::Hull& h : hints.occluders) {
-      if (h.body_id != t.body_id && InsideConvexHull(h.points, pred)) {
-        occluded = true;
-        break;
-      }
-    }
-    if (occluded) {
-      if (t.occluded_frames >= options_.max_occluded_frames || !InBorder(pred, image, border)) continue;
-      t.status = TrackStatus::kOccluded;
-      ++t.occluded_frames;
-      t.prev_uv = t.uv;
-      t.uv = pred;
-      ++stats_.occluded;
-      next_tracks.push_back(std::move(t));
-      continue;
-    }
     if (t.status == TrackStatus::kOccluded) {
-      reappearing.emplace_back(i, pred);
+      if (inside_other_hull(t, pred)) {
+        if (t.occluded_frames >= options_.max_occluded_frames || !InBorder(pred, image, border)) continue;
+        ++t.occluded_frames;
+        t.prev_uv = t.uv;
+        t.uv = pred;
+        ++stats_.occluded;
+        next_tracks.push_back(std::move(t));
+      } else {
+        reappearing.emplace_back(i, pred);
+      }
       continue;
     }
     klt_index.push_back(i);
@@ -133,14 +134,24 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     const float fb = d.dot(d);
     const bool ok = status[k] && back_status[k] && fb <= fb2 && next.allFinite() &&
                     InBorder(next, image, border);
-    if (!ok) {
-      ++stats_.lost;
-      recently_lost_.push_back(std::move(t));
-      continue;
-    }
     cv::Mat patch;
-    if (!ExtractPatch(image, next, options_.patch_size, &patch) ||
-        (!t.patch.empty() && PatchNcc(patch, t.patch) < options_.min_patch_ncc)) {
+    const bool matched = ok && ExtractPatch(image, next, options_.patch_size, &patch) &&
+                         (t.patch.empty() || PatchNcc(patch, t.patch) >= options_.min_patch_ncc) &&
+                         (t.anchor.empty() || PatchNcc(patch, t.anchor) >= options_.min_anchor_ncc);
+    if (!matched) {
+      // A failed match of a static track predicted behind a moving object's hull is an
+      // occlusion (thesis sec. 2.2 c): keep it, unmatched, until it reappears.
+      const Eigen::Vector2f& pred = predicted[klt_index[k]];
+      if (t.body_id == 0 && t.age >= 3 && pred.allFinite() && InBorder(pred, image, border) &&
+          inside_other_hull(t, pred)) {
+        t.status = TrackStatus::kOccluded;
+        t.occluded_frames = 1;
+        t.prev_uv = t.uv;
+        t.uv = pred;
+        ++stats_.occluded;
+        next_tracks.push_back(std::move(t));
+        continue;
+      }
       ++stats_.lost;
       recently_lost_.push_back(std::move(t));
       continue;
@@ -344,6 +355,7 @@ void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
         t.last_seen_frame = frame_index;
         t.is_new = true;
         if (!ExtractPatch(image, t.uv, options_.patch_size, &t.patch)) continue;
+        t.anchor = t.patch;
         cv::circle(mask, cv::Point(x, y), radius, cv::Scalar(0), -1);
         ++count[cu];
         ++created;

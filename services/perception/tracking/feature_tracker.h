@@ -41,6 +41,7 @@ struct TrackerOptions {
   double max_patch_score = 400.0;      // accept a guided match below this ZSSD / pixel (gray^2)
   double velocity_smoothing = 0.5;     // weight of the newest flow in the velocity estimate
   double min_patch_ncc = 0.6;          // appearance check of every KLT match against the track's template (NCC)
+  double min_anchor_ncc = 0.4;         // ... and against its first appearance: catches tracks dragged along occlusion boundaries (NCC)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(max_features, 0);
@@ -63,6 +64,7 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION_GT(max_patch_score, 0.0);
     MBSLAM_CHECK_OPTION(velocity_smoothing > 0.0 && velocity_smoothing <= 1.0);
     MBSLAM_CHECK_OPTION(min_patch_ncc >= -1.0 && min_patch_ncc < 1.0);
+    MBSLAM_CHECK_OPTION(min_anchor_ncc >= -1.0 && min_anchor_ncc < 1.0);
     return true;
   }
   template <typename V>
@@ -86,6 +88,7 @@ struct TrackerOptions {
     v("max_patch_score", &max_patch_score, "guided match acceptance, ZSSD per pixel (gray^2)");
     v("velocity_smoothing", &velocity_smoothing, "weight of the newest flow in track velocity (0..1]");
     v("min_patch_ncc", &min_patch_ncc, "appearance check of KLT matches against the template (NCC)");
+    v("min_anchor_ncc", &min_anchor_ncc, "appearance check against the first observation (NCC)");
   }
 };
 
@@ -116,7 +119,8 @@ class FeatureTracker {
   explicit FeatureTracker(const TrackerOptions& options);
 
   // Tracks into the new image (pyramid level 0 = full resolution), then detects new
-  // features in empty grid cells.
+  // features in empty grid cells. The tracker keeps `pyramid` (shallow cv::Mat copies)
+  // as the previous image: the caller must not write into its buffers afterwards.
   void TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t frame_index, const TrackingHints& hints);
 
   // Stage 2: re-finds tracks that are occluded or were lost in this image near the

@@ -27,6 +27,7 @@ struct Track {
   int occluded_frames = 0;         // consecutive frames spent occluded
   float match_error = 0.0f;        // forward-backward error of the last match (px)
   cv::Mat patch;                   // template at the last observation (ZSSD re-detection)
+  cv::Mat anchor;                  // template at the first observation (drift check)
   // Set by segmentation / SLAM (fed back to the tracker):
   int body_id = -1;                // 0 static world, > 0 object, -1 unassigned
   float p_static = 0.5f;           // P(static w.r.t. the static world)

@@ -1,0 +1,191 @@
+// mbslam-eval-segmentation: scores the moving-feature labels a perception run
+// published (PERCEPTION_TRACKS in its output log) against a simulator sequence's
+// ground truth (per-pixel body masks and the bodies' velocities on GROUND_TRUTH).
+//
+//   mbslam-eval-segmentation --run OUT.lcmlog --sequence SIM_DIR [--settle N] [--name NAME]
+//
+// A feature is labelled moving when its body is not the static world; it truly moves
+// when the mask under it is a body that moves in that frame (a previously static
+// object counts as static until it starts). Frames from `settle` frames after each
+// mover's appearance are scored. Prints a summary and, last, one JSON line:
+//   moving_recall, moving_precision, detection_delay_frames (per object), misclassification
+//   (track level, Hungarian), frames_scored.
+
+#include <cmath>
+#include <cstdlib>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/lcm/channels.h"
+#include "common/lcm/lcm_log.h"
+#include "common/lcm/wire_check.h"
+#include "mbslam/ground_truth_t.hpp"
+#include "mbslam/tracks_t.hpp"
+#include "tools/tracks/misclassification.h"
+
+namespace mbslam {
+namespace {
+
+int Run(int argc, char** argv) {
+  std::string run, seq, name = "sequence";
+  int settle = 10;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--run" && i + 1 < argc) run = argv[++i];
+    else if (a == "--sequence" && i + 1 < argc) seq = argv[++i];
+    else if (a == "--settle" && i + 1 < argc) settle = std::atoi(argv[++i]);
+    else if (a == "--name" && i + 1 < argc) name = argv[++i];
+    else {
+      std::fprintf(stderr, "usage: mbslam-eval-segmentation --run OUT.lcmlog --sequence SIM_DIR [--settle N]\n");
+      return 2;
+    }
+  }
+  if (run.empty() || seq.empty()) {
+    std::fprintf(stderr, "mbslam-eval-segmentation: --run and --sequence are required\n");
+    return 2;
+  }
+  const ChannelOptions ch;
+  // Ground truth: which bodies move in which frame.
+  std::vector<LcmLogEvent> gt_events;
+  Status s = ReadLcmLog(seq + "/sequence.lcmlog", &gt_events, ch.ground_truth);
+  if (!s.ok()) {
+    std::fprintf(stderr, "%s\n", s.message().c_str());
+    return 1;
+  }
+  std::map<int64_t, std::set<int>> moving_bodies;  // frame -> bodies moving
+  std::map<int, int64_t> first_moving_frame;
+  for (const LcmLogEvent& e : gt_events) {
+    mbslam::ground_truth_t gt{};
+    if (!DecodeLcmMessage(e.data.data(), e.data.size(), &gt).ok()) continue;
+    for (const auto& b : gt.bodies) {
+      const double v = std::sqrt(b.linear_velocity[0] * b.linear_velocity[0] +
+                                 b.linear_velocity[1] * b.linear_velocity[1] +
+                                 b.linear_velocity[2] * b.linear_velocity[2]);
+      const double w = std::sqrt(b.angular_velocity[0] * b.angular_velocity[0] +
+                                 b.angular_velocity[1] * b.angular_velocity[1] +
+                                 b.angular_velocity[2] * b.angular_velocity[2]);
+      if ((v > 0.02 || w > 0.02) && b.visible) {
+        moving_bodies[gt.frame_seq].insert(b.id);
+        first_moving_frame.try_emplace(b.id, gt.frame_seq);
+      }
+    }
+  }
+  std::vector<LcmLogEvent> events;
+  s = ReadLcmLog(run, &events, ch.perception_tracks);
+  if (!s.ok() || events.empty()) {
+    std::fprintf(stderr, "no PERCEPTION_TRACKS in %s\n", run.c_str());
+    return 1;
+  }
+  int64_t tp = 0, fp = 0, fn = 0, frames = 0;
+  std::map<int, int64_t> detected_frame;  // true body -> first frame its features were mostly moving with an object
+  std::map<int64_t, std::map<int, int>> truth_votes, pred_votes;  // track -> body -> count
+  for (const LcmLogEvent& e : events) {
+    mbslam::tracks_t t{};
+    if (!DecodeLcmMessage(e.data.data(), e.data.size(), &t).ok()) continue;
+    char path[64];
+    std::snprintf(path, sizeof(path), "/masks/%06lld.png", static_cast<long long>(t.frame_seq));
+    const cv::Mat mask = cv::imread(seq + path, cv::IMREAD_UNCHANGED);
+    if (mask.empty()) continue;
+    const std::set<int>& movers = moving_bodies[t.frame_seq];
+    // Distance of every pixel to the nearest truly moving pixel (boundary analysis).
+    cv::Mat not_moving(mask.size(), CV_8UC1, cv::Scalar(255));
+    for (int y = 0; y < mask.rows; ++y) {
+      for (int x = 0; x < mask.cols; ++x) {
+        const int b = mask.type() == CV_16UC1 ? mask.at<uint16_t>(y, x) : mask.at<uint8_t>(y, x);
+        if (b != 0 && movers.count(b)) not_moving.at<uint8_t>(y, x) = 0;
+      }
+    }
+    cv::Mat dist;
+    cv::distanceTransform(not_moving, dist, cv::DIST_L2, 3);
+    std::map<int, std::pair<int, int>> per_body;  // body -> (features, labelled moving with an object)
+    bool scored = false;
+    for (const auto& f : t.tracks) {
+      if (f.flags & (mbslam::feature_track_t::FLAG_OCCLUDED | mbslam::feature_track_t::FLAG_NEW)) continue;
+      const int u = static_cast<int>(std::lround(f.u)), v = static_cast<int>(std::lround(f.v));
+      if (u < 0 || v < 0 || u >= mask.cols || v >= mask.rows) continue;
+      const int body = mask.type() == CV_16UC1 ? mask.at<uint16_t>(v, u) : mask.at<uint8_t>(v, u);
+      const bool truly_moving = body != 0 && movers.count(body);
+      const bool labelled_moving = f.body_id != 0;
+      ++truth_votes[f.id][truly_moving ? body : 0];
+      ++pred_votes[f.id][f.body_id];
+      if (truly_moving) {
+        per_body[body].first++;
+        if (f.body_id > 0) per_body[body].second++;
+      }
+      // Score only after the movers present have had `settle` frames.
+      bool settled = true;
+      for (int b : movers) {
+        auto it = first_moving_frame.find(b);
+        if (it != first_moving_frame.end() && t.frame_seq < it->second + settle) settled = false;
+      }
+      if (!settled) continue;
+      scored = true;
+      tp += truly_moving && labelled_moving;
+      fp += !truly_moving && labelled_moving;
+      if (std::getenv("EVAL_DUMP_FP") && !truly_moving && labelled_moving) {
+        std::printf("FP frame %lld id %lld uv %.0f %.0f body %d mask %d p %.3f epi %.2f fvb %.3f age %d dist %.1f\n",
+                    static_cast<long long>(t.frame_seq), static_cast<long long>(f.id), f.u, f.v, f.body_id,
+                    body, f.p_static, f.epipolar_px, f.fvb, f.age, dist.at<float>(v, u));
+      }
+      fn += truly_moving && !labelled_moving;
+    }
+    frames += scored;
+    for (const auto& [body, counts] : per_body) {
+      if (counts.first >= 3 && 2 * counts.second >= counts.first) detected_frame.try_emplace(body, t.frame_seq);
+    }
+  }
+  // Track-level misclassification: each track's majority truth vs majority label.
+  std::vector<int> truth, pred;
+  for (const auto& [id, votes] : truth_votes) {
+    auto majority = [](const std::map<int, int>& m) {
+      int best = 0, count = -1;
+      for (const auto& [k, c] : m) {
+        if (c > count) {
+          count = c;
+          best = k;
+        }
+      }
+      return best;
+    };
+    truth.push_back(majority(votes));
+    pred.push_back(majority(pred_votes[id]));
+  }
+  const double recall = tp + fn > 0 ? static_cast<double>(tp) / (tp + fn) : 1.0;
+  const double precision = tp + fp > 0 ? static_cast<double>(tp) / (tp + fp) : 1.0;
+  const double miscl = Misclassification(truth, pred);
+  std::printf("%s: frames scored %lld, moving features: recall %.3f precision %.3f (tp %lld fp %lld fn %lld)\n",
+              name.c_str(), static_cast<long long>(frames), recall, precision,
+              static_cast<long long>(tp), static_cast<long long>(fp), static_cast<long long>(fn));
+  std::printf("track-level misclassification %.2f%% over %zu tracks\n", 100.0 * miscl, truth.size());
+  std::string delays;
+  double delay_sum = 0.0;
+  int delay_n = 0;
+  for (const auto& [body, first] : first_moving_frame) {
+    auto it = detected_frame.find(body);
+    const long long delay = it == detected_frame.end() ? -1 : static_cast<long long>(it->second - first);
+    std::printf("  body %d: moving from frame %lld, detected %s\n", body, static_cast<long long>(first),
+                delay < 0 ? "never" : ("after " + std::to_string(delay) + " frames").c_str());
+    delays += (delays.empty() ? "" : ", ") + std::string("\"") + std::to_string(body) + "\": " + std::to_string(delay);
+    if (delay >= 0) {
+      delay_sum += static_cast<double>(delay);
+      ++delay_n;
+    }
+  }
+  std::printf("{\"name\": \"%s\", \"moving_recall\": %.4f, \"moving_precision\": %.4f, \"misclassification\": %.4f, "
+              "\"frames_scored\": %lld, \"objects\": %zu, \"objects_detected\": %d, \"mean_detection_delay_frames\": %.2f, "
+              "\"detection_delay_frames\": {%s}}\n",
+              name.c_str(), recall, precision, miscl, static_cast<long long>(frames), first_moving_frame.size(),
+              delay_n, delay_n ? delay_sum / delay_n : -1.0, delays.c_str());
+  return 0;
+}
+
+}  // namespace
+}  // namespace mbslam
+
+int main(int argc, char** argv) { return mbslam::Run(argc, argv); }
