@@ -214,6 +214,31 @@ Status ReadCamVid(const std::string& root, std::vector<CamVidFrame>* frames) {
 bool IsCamVidStaticClass(int label) { return label >= kCamVidSky && label <= kCamVidFence; }
 bool IsCamVidMovableClass(int label) { return label >= kCamVidCar && label <= kCamVidBicyclist; }
 
+void CamVidFeatureStats::Add(const CamVidFeatureStats& o) {
+  moving += o.moving;
+  on_static += o.on_static;
+  on_movable += o.on_movable;
+  on_void += o.on_void;
+  static_fraction = moving > 0 ? static_cast<double>(on_static) / moving : 0.0;
+  movable_fraction = moving > 0 ? static_cast<double>(on_movable) / moving : 0.0;
+}
+
+CamVidFeatureStats CamVidMovingFeatureStats(const std::vector<LabelledFeature>& features, const cv::Mat& labels) {
+  CamVidFeatureStats s;
+  for (const auto& f : features) {
+    if (!f.moving) continue;
+    const int x = static_cast<int>(std::lround(f.u)), y = static_cast<int>(std::lround(f.v));
+    if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows) continue;
+    const int label = labels.at<uint8_t>(y, x);
+    ++s.moving;
+    if (IsCamVidStaticClass(label)) ++s.on_static;
+    else if (IsCamVidMovableClass(label)) ++s.on_movable;
+    else ++s.on_void;
+  }
+  s.Add(CamVidFeatureStats());  // computes the fractions
+  return s;
+}
+
 Status ReadTumSubset(const std::string& root, TumSubset* subset) {
   *subset = TumSubset();
   MBSLAM_RETURN_IF_ERROR(ReadTumTrajectory((fs::path(root) / "truth_cam_poses.txt").string(), &subset->truth));

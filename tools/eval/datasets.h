@@ -18,6 +18,7 @@
 #include "common/util/status.h"
 #include "services/perception/geometry/camera.h"
 #include "tools/eval/object_metrics.h"
+#include "tools/eval/segmentation_metrics.h"
 #include "tools/eval/trajectory.h"
 
 namespace mbslam {
@@ -73,6 +74,18 @@ enum CamVidClass {
 Status ReadCamVid(const std::string& root, std::vector<CamVidFrame>* frames);
 bool IsCamVidStaticClass(int label);   // sky, building, pole, road, pavement, tree, sign, fence
 bool IsCamVidMovableClass(int label);  // car, pedestrian, bicyclist
+
+// Where the features labelled moving fall in a CamVid label image.
+struct CamVidFeatureStats {
+  int moving = 0;       // features labelled moving (inside the image) (count)
+  int on_static = 0;    // ... on static classes: false detections (count)
+  int on_movable = 0;   // ... on cars, pedestrians, bicyclists (count)
+  int on_void = 0;      // ... on void / unknown labels (count)
+  double static_fraction = 0.0;   // on_static / moving (0 if none)
+  double movable_fraction = 0.0;  // on_movable / moving (0 if none)
+  void Add(const CamVidFeatureStats& other);
+};
+CamVidFeatureStats CamVidMovingFeatureStats(const std::vector<LabelledFeature>& features, const cv::Mat& labels);
 
 // ---------------------------------------------------------------- TUM RGB-D subset
 struct TumSubset {

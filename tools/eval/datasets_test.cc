@@ -4,6 +4,7 @@
 #include "tools/eval/datasets.h"
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <unistd.h>
 
 #include <cmath>
@@ -61,6 +62,21 @@ TEST(Tracks, ParseWriteAndFolder) {
   EXPECT_FALSE(ParseTracks("2 2 640 480\n1\n", &set).ok());             // a label missing
 }
 
+TEST(CamVid, MovingFeatureStats) {
+  cv::Mat labels(10, 10, CV_8UC1, cv::Scalar(kCamVidRoad));
+  labels(cv::Rect(5, 0, 5, 5)).setTo(kCamVidCar);
+  labels.at<uint8_t>(9, 9) = kCamVidVoid;
+  const std::vector<LabelledFeature> features = {
+      {1, 1, true}, {7, 2, true}, {9, 9, true}, {2, 2, false}, {20, 20, true}};
+  const CamVidFeatureStats s = CamVidMovingFeatureStats(features, labels);
+  EXPECT_EQ(s.moving, 3);
+  EXPECT_EQ(s.on_static, 1);
+  EXPECT_EQ(s.on_movable, 1);
+  EXPECT_EQ(s.on_void, 1);
+  EXPECT_DOUBLE_EQ(s.static_fraction, 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(s.movable_fraction, 1.0 / 3.0);
+}
+
 TEST(SharedData, Hopkins155) {
   REQUIRE_DATA("hopkins155", root);
   std::vector<TrackSet> sets;
@@ -106,6 +122,13 @@ TEST(SharedData, CamVid) {
   EXPECT_TRUE(IsCamVidMovableClass(kCamVidPedestrian));
   EXPECT_FALSE(IsCamVidStaticClass(kCamVidVoid));
   EXPECT_FALSE(IsCamVidMovableClass(kCamVidVoid));
+  const cv::Mat labels = cv::imread(frames[0].label, cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(labels.empty());
+  EXPECT_EQ(labels.size(), cv::Size(480, 360));
+  double max_label;
+  cv::minMaxLoc(labels, nullptr, &max_label);
+  EXPECT_LE(max_label, kCamVidVoid);
+  EXPECT_GT(cv::countNonZero(labels == kCamVidRoad), 1000);  // a street scene
 }
 
 TEST(SharedData, TumSubset) {

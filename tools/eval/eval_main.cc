@@ -6,6 +6,7 @@
 //   mbslam-eval seg --pred labels.txt --truth seq.tracks.txt
 //   mbslam-eval seg --pred-dir predictions/ --tracks-dir ../shared/data/hopkins155
 //   mbslam-eval masks --pred-dir masks/ --gt-dir ../shared/data/davis2016/Annotations/camel
+//   mbslam-eval camvid --features moving_features.txt
 //   mbslam-eval objects --est-log run.lcmlog --gt-log seq.lcmlog
 //   mbslam-eval perturb --in gt.tum --out est.tum --scale 2 --rot-deg 30 --noise 0.05
 //   mbslam-eval perturb-labels --truth seq.tracks.txt --out pred.txt --wrong 5
@@ -313,27 +314,32 @@ int RunSeg(const Args& args) {
 
 // ---------------------------------------------------------------- masks
 
+// Features "frame_stem u v moving(0/1)" per line ('#' comments), grouped by frame.
+Status ReadFeatureFile(const std::string& path, std::map<std::string, std::vector<eval::LabelledFeature>>* features) {
+  std::string text;
+  MBSLAM_RETURN_IF_ERROR(mbslam::ReadFileToString(path, &text));
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    std::string stem;
+    eval::LabelledFeature f;
+    int moving = 0;
+    if (!(ls >> stem >> f.u >> f.v >> moving)) return Status::Error(path + ": bad feature line '" + line + "'");
+    f.moving = moving != 0;
+    (*features)[stem].push_back(f);
+  }
+  return Status::Ok();
+}
+
 int RunMasks(const Args& args) {
   const std::string pred_dir = args.Get("pred-dir"), gt_dir = args.Get("gt-dir");
   if (pred_dir.empty() || gt_dir.empty()) return Fail("masks: give --pred-dir DIR --gt-dir DIR");
-  // Features "frame_stem u v moving(0/1)" per line, optional.
   std::map<std::string, std::vector<eval::LabelledFeature>> features;
   if (args.Has("features")) {
-    std::string text;
-    Status st = mbslam::ReadFileToString(args.Get("features"), &text);
+    const Status st = ReadFeatureFile(args.Get("features"), &features);
     if (!st.ok()) return Fail(st.message());
-    std::istringstream in(text);
-    std::string line;
-    while (std::getline(in, line)) {
-      if (line.empty() || line[0] == '#') continue;
-      std::istringstream ls(line);
-      std::string stem;
-      eval::LabelledFeature f;
-      int moving = 0;
-      if (!(ls >> stem >> f.u >> f.v >> moving)) return Fail("masks: bad feature line '" + line + "'");
-      f.moving = moving != 0;
-      features[stem].push_back(f);
-    }
   }
   std::vector<std::string> gt_files;
   std::error_code ec;
@@ -374,6 +380,38 @@ int RunMasks(const Args& args) {
                 total.true_positives, total.false_positives, total.false_negatives);
     j.Set("precision", total.precision).Set("recall", total.recall).Set("f1", total.f1);
   }
+  return Finish(j, args);
+}
+
+// ---------------------------------------------------------------- camvid
+
+int RunCamVid(const Args& args) {
+  const std::string root = args.Get("root", eval::DataSetPath("camvid_0016E5_15hz"));
+  if (root.empty()) return Fail("camvid: no --root and no camvid_0016E5_15hz under " + eval::DataRoot());
+  if (!args.Has("features")) return Fail("camvid: give --features FILE (\"stem u v moving\" per line)");
+  std::map<std::string, std::vector<eval::LabelledFeature>> features;
+  Status st = ReadFeatureFile(args.Get("features"), &features);
+  if (!st.ok()) return Fail(st.message());
+  std::vector<eval::CamVidFrame> frames;
+  st = eval::ReadCamVid(root, &frames);
+  if (!st.ok()) return Fail(st.message());
+  eval::CamVidFeatureStats total;
+  int used = 0;
+  for (const auto& f : frames) {
+    auto it = features.find(fs::path(f.label).stem().string());
+    if (it == features.end()) continue;
+    const cv::Mat labels = cv::imread(f.label, cv::IMREAD_GRAYSCALE);
+    if (labels.empty()) return Fail("cannot read " + f.label);
+    total.Add(eval::CamVidMovingFeatureStats(it->second, labels));
+    ++used;
+  }
+  std::printf("CamVid: %d labelled frames with features; %d moving features: %.4f on static classes, %.4f on "
+              "cars / pedestrians / bicyclists, %d on void\n",
+              used, total.moving, total.static_fraction, total.movable_fraction, total.on_void);
+  Json j = Json::Object();
+  j.Set("metric", "camvid").Set("frames", used).Set("moving_features", total.moving);
+  j.Set("static_fraction", total.static_fraction).Set("movable_fraction", total.movable_fraction);
+  j.Set("void", total.on_void);
   return Finish(j, args);
 }
 
@@ -563,6 +601,8 @@ void Usage() {
            --pred-dir DIR [--tracks-dir DIR (default: Hopkins 155)] [--pred-suffix .labels.txt]
   masks    region IoU and moving-feature precision / recall
            --pred-dir DIR --gt-dir DIR [--features FILE ("stem u v moving" per line)]
+  camvid   where features labelled moving fall in CamVid's classes (false detections on static classes)
+           --features FILE ("stem u v moving" per line) [--root DIR]
   objects  per-object trajectory / scale / depth errors and predicted-volume hit rate
            --est-log LOG --gt-log LOG [--horizon-us N] [--align sim3|se3] [--max-match-m M]
   perturb  write a trajectory with a known similarity and noise (expected ATE printed)
@@ -587,6 +627,7 @@ int main(int argc, char** argv) {
   if (cmd == "seg") return RunSeg(args);
   if (cmd == "masks") return RunMasks(args);
   if (cmd == "objects") return RunObjects(args);
+  if (cmd == "camvid") return RunCamVid(args);
   if (cmd == "perturb") return RunPerturb(args);
   if (cmd == "perturb-labels") return RunPerturbLabels(args);
   if (cmd == "datasets") return RunDatasets(args);

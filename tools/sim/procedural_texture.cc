@@ -181,20 +181,26 @@ cv::Mat FractalNoise(int width, int height, uint64_t seed, double largest_cell_p
   double amplitude = 1.0;
   double cell = std::max(1.0, largest_cell_px);
   for (int k = 0; k < octaves && cell >= 1.0; ++k) {
-    const int gw = static_cast<int>(std::ceil(width / cell)) + 4;
-    const int gh = static_cast<int>(std::ceil(height / cell)) + 4;
-    cv::Mat grid(gh, gw, CV_32F);
-    for (int r = 0; r < gh; ++r) {
-      for (int c = 0; c < gw; ++c) grid.at<float>(r, c) = static_cast<float>(rng.Normal(1.0));
+    if (cell < 1.5) {  // finer than the pixels: white noise
+      cv::Mat white(height, width, CV_32F);
+      cv::RNG cv_rng(rng.Next());
+      cv_rng.fill(white, cv::RNG::NORMAL, 0.0, 1.0);
+      sum += amplitude * white;
+    } else {
+      const int gw = static_cast<int>(std::ceil(width / cell)) + 3;
+      const int gh = static_cast<int>(std::ceil(height / cell)) + 3;
+      cv::Mat grid(gh, gw, CV_32F);
+      for (int r = 0; r < gh; ++r) {
+        for (int c = 0; c < gw; ++c) grid.at<float>(r, c) = static_cast<float>(rng.Normal(1.0));
+      }
+      // Smooth (bicubic) upsampling of the random grid, cropped at a random sub-cell
+      // offset so that octaves do not share their cell boundaries.
+      cv::Mat up;
+      cv::resize(grid, up, cv::Size(cvRound(gw * cell), cvRound(gh * cell)), 0, 0, cv::INTER_CUBIC);
+      const int ox = static_cast<int>(rng.Uniform(cell, 2.0 * cell));
+      const int oy = static_cast<int>(rng.Uniform(cell, 2.0 * cell));
+      sum += amplitude * up(cv::Rect(std::min(ox, up.cols - width), std::min(oy, up.rows - height), width, height));
     }
-    // Smooth (bicubic) upsampling of the random grid straight into the output window, at a
-    // random sub-cell offset so that octaves do not share their cell boundaries.
-    const double ox = rng.Uniform(1.0, 2.0), oy = rng.Uniform(1.0, 2.0);
-    const cv::Matx23d src_from_dst(1.0 / cell, 0.0, ox, 0.0, 1.0 / cell, oy);
-    cv::Mat up;
-    cv::warpAffine(grid, up, src_from_dst, cv::Size(width, height), cv::INTER_CUBIC | cv::WARP_INVERSE_MAP,
-                   cv::BORDER_REPLICATE);
-    sum += amplitude * up;
     amplitude *= persistence;
     cell *= 0.5;
   }

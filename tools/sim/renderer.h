@@ -27,7 +27,8 @@ struct RendererOptions {
   double near_m = 0.05;            // near clipping distance (m); no far plane (reversed z)
   double detail_strength = 0.25;   // contrast of the fine detail texture [0, 1]
   double detail_period_m = 1.7;    // repetition period of the detail texture (m)
-  double anisotropy = 1.0;         // anisotropic texture filtering, 1 = off; costly in llvmpipe (ratio)
+  double anisotropy = 1.0;         // GL anisotropic texture filtering, 1 = off; very slow in llvmpipe (ratio)
+  int anisotropic_taps = 4;        // shader anisotropic filtering: taps along the footprint, 1 = off (count)
   std::array<double, 3> sky_bgr = {0.92, 0.80, 0.62};  // background colour, BGR [0, 1]
 
   bool Check() const {
@@ -37,6 +38,8 @@ struct RendererOptions {
     MBSLAM_CHECK_OPTION_LE(detail_strength, 1.0);
     MBSLAM_CHECK_OPTION_GT(detail_period_m, 0.0);
     MBSLAM_CHECK_OPTION_GE(anisotropy, 1.0);
+    MBSLAM_CHECK_OPTION_GE(anisotropic_taps, 1);
+    MBSLAM_CHECK_OPTION_LE(anisotropic_taps, 16);
     return true;
   }
   template <typename V>
@@ -45,7 +48,8 @@ struct RendererOptions {
     v("near_m", &near_m, "near clipping distance (m)");
     v("detail_strength", &detail_strength, "contrast of the fine detail texture [0, 1]");
     v("detail_period_m", &detail_period_m, "repetition period of the detail texture (m)");
-    v("anisotropy", &anisotropy, "anisotropic texture filtering, 1 = off (ratio)");
+    v("anisotropy", &anisotropy, "GL anisotropic texture filtering, 1 = off; very slow in llvmpipe (ratio)");
+    v("anisotropic_taps", &anisotropic_taps, "shader anisotropic filtering taps, 1 = off (count)");
     v("sky_bgr", &sky_bgr, "background colour, BGR [0, 1]");
   }
 };

@@ -63,7 +63,7 @@ TEST(Scenarios, AllRegistered) {
 
 // multi: 5 movers that cover at least 25 % of the image on average over the sequence.
 TEST(Scenarios, MultiCoversAQuarterOfTheImage) {
-  Simulator* sim = Get("multi", 160);
+  Simulator* sim = Get("multi");
   ASSERT_TRUE(sim);
   EXPECT_EQ(sim->MovingBodyIds().size(), 5u);
   SimFrame f;
@@ -83,7 +83,7 @@ TEST(Scenarios, MultiCoversAQuarterOfTheImage) {
 // Outside multi, movers never fill the frame and nothing sits right in front of the lens.
 TEST(Scenarios, ObjectsDoNotFillTheFrame) {
   for (const auto& name : ScenarioNames()) {
-    Simulator* sim = Get(name, 160);
+    Simulator* sim = Get(name);
     ASSERT_TRUE(sim);
     SimFrame f;
     for (int k = 0; k < sim->num_frames(); k += 10) {
@@ -102,7 +102,7 @@ TEST(Scenarios, ObjectsDoNotFillTheFrame) {
 
 // crossing: movers enter and leave the view, and occlude each other.
 TEST(Scenarios, CrossingEntersLeavesAndOccludes) {
-  Simulator* sim = Get("crossing", 160);
+  Simulator* sim = Get("crossing");
   ASSERT_TRUE(sim);
   const auto ids = sim->MovingBodyIds();
   std::vector<std::vector<bool>> visible(ids.size());
@@ -190,7 +190,7 @@ EpipolarStats BodyEpipolar(const Simulator& sim, int id, int ka, int kb) {
 // in their epipolar planes (epipolar test blind) although they move in the image; in
 // crossing the same test sees the car clearly.
 TEST(Scenarios, FollowingIsDegenerate) {
-  Simulator* sim = Get("following", 160);
+  Simulator* sim = Get("following");
   ASSERT_TRUE(sim);
   int checked = 0;
   for (int id : sim->MovingBodyIds()) {
@@ -211,7 +211,7 @@ TEST(Scenarios, FollowingIsDegenerate) {
     EXPECT_GT(in_cam.z(), 3.0);
     EXPECT_LT(std::abs(in_cam.x()), 0.2);
   }
-  Simulator* crossing = Get("crossing", 160);
+  Simulator* crossing = Get("crossing");
   ASSERT_TRUE(crossing);
   double worst = 0.0;
   for (int k = 30; k + 30 < crossing->num_frames(); k += 30) {
@@ -222,7 +222,7 @@ TEST(Scenarios, FollowingIsDegenerate) {
 
 // previously_static: the car and the person stand still, then move, and are seen both ways.
 TEST(Scenarios, PreviouslyStaticObjectsStartMoving) {
-  Simulator* sim = Get("previously_static", 160);
+  Simulator* sim = Get("previously_static");
   ASSERT_TRUE(sim);
   SimFrame f;
   for (int id : {1, 2}) {
@@ -247,7 +247,7 @@ TEST(Scenarios, PreviouslyStaticObjectsStartMoving) {
 }
 
 TEST(Scenarios, RotationOnlyHasNoTranslation) {
-  Simulator* sim = Get("rotation_only", 160);
+  Simulator* sim = Get("rotation_only");
   ASSERT_TRUE(sim);
   const Rigid3d first = sim->WorldFromCam(sim->FrameUtime(0));
   double max_angle = 0.0;
@@ -262,7 +262,7 @@ TEST(Scenarios, RotationOnlyHasNoTranslation) {
 // robot_odometry: a 50 Hz odometry stream, whose truth is the camera trajectory seen
 // through the extrinsic, and whose noise makes it drift by a realistic amount.
 TEST(Scenarios, RobotOdometryStream) {
-  Simulator* sim = Get("robot_odometry", 160);
+  Simulator* sim = Get("robot_odometry");
   ASSERT_TRUE(sim);
   ASSERT_TRUE(sim->has_odometry());
   ASSERT_TRUE(sim->base_from_cam().has_value());
@@ -306,7 +306,7 @@ TEST(Scenarios, RobotOdometryStream) {
 // and on every large mover, and pyramidal KLT tracks that follow the true motion.
 TEST(Scenarios, TexturedAndTrackable) {
   for (const auto& name : ScenarioNames()) {
-    Simulator* sim = Get(name, 320);
+    Simulator* sim = Get(name);
     ASSERT_TRUE(sim);
     SimFrame a, b;
     const int k = sim->num_frames() / 2;

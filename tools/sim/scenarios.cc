@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <random>
+#include <thread>
 
 #include "common/util/logging.h"
 
@@ -231,13 +232,13 @@ ScenarioPlan MultiPlan(const Timeline& tl, uint64_t seed) {
     return s;
   };
   plan.camera = HandheldCamera(head, spec, tl, seed);
-  plan.movers.push_back(EllipseMover(BodyClass::kCar, kCarExtent, {8.0, -1.5}, 1.5, 3.5, 2.5, 0.0, 1, tl,
+  plan.movers.push_back(EllipseMover(BodyClass::kCar, kCarExtent, {7.8, -1.5}, 1.5, 3.5, 2.5, 0.0, 1, tl,
                                      cv::Scalar(0.1, 0.1, 0.7)));
   plan.movers.push_back(EllipseMover(BodyClass::kCar, kCarExtent, {13.5, 2.5}, 1.5, 4.0, 3.0, 1.0, -1, tl,
                                      cv::Scalar(0.75, 0.6, 0.2)));
-  plan.movers.push_back(EllipseMover(BodyClass::kPerson, kPersonExtent, {4.2, 1.6}, 0.9, 0.9, 1.1, 0.5, 1, tl));
-  plan.movers.push_back(EllipseMover(BodyClass::kPerson, kPersonExtent, {4.8, -1.8}, 0.3, 1.4, 1.0, 2.0, -1, tl));
-  plan.movers.push_back(EllipseMover(BodyClass::kPerson, kPersonExtent, {2.8, -0.6}, 0.5, 0.5, 0.8, 4.0, 1, tl));
+  plan.movers.push_back(EllipseMover(BodyClass::kPerson, kPersonExtent, {3.6, 1.45}, 0.8, 0.8, 1.1, 0.5, 1, tl));
+  plan.movers.push_back(EllipseMover(BodyClass::kPerson, kPersonExtent, {4.2, -1.6}, 0.3, 1.3, 1.0, 2.0, -1, tl));
+  plan.movers.push_back(EllipseMover(BodyClass::kPerson, kPersonExtent, {2.5, -0.4}, 0.45, 0.45, 0.8, 4.0, 1, tl));
   plan.clutter_per_m2 = 1.0 / 120.0;
   return plan;
 }
@@ -279,6 +280,30 @@ ScenarioPlan RotationOnlyPlan(const Timeline& tl, uint64_t seed) {
   return plan;
 }
 
+ScenarioPlan DrivingPlan(const Timeline& tl, uint64_t seed) {
+  ScenarioPlan plan;
+  const double d = tl.duration_s + 2.0;
+  // A car-mounted camera: smooth forward motion at 6 m/s with a gentle lane curve, small
+  // suspension pitch / roll.
+  PlanarPath path(0.0, 0.0, 0.0, 6.0);
+  path.Drive(3.0).Drive(4.0, 0.0, 0.03).Drive(d, 0.0, -0.02);
+  const PoseTrack base = RobotBase(path, tl, seed, 0.002, 0.003);
+  plan.base_from_cam = ForwardCameraMount(Eigen::Vector3d(1.5, 0.0, 1.3), 0.04);
+  plan.camera = CameraOnBase(base, plan.base_from_cam, tl);
+  // Its lane follows the camera's path; the oncoming lane is 3.5 m to the left.
+  PlanarPath ahead(18.0, 0.0, 0.0, 5.5);
+  ahead.Drive(3.0).Drive(4.0, 0.0, 0.03).Drive(d, 0.0, -0.02);
+  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, ahead, tl, cv::Scalar(0.2, 0.2, 0.6)));
+  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, PlanarPath(75.0, 5.5, M_PI, 8.0).Drive(d), tl,
+                                  cv::Scalar(0.7, 0.7, 0.7)));
+  plan.movers.push_back(
+      PathMover(BodyClass::kPerson, kPersonExtent, PlanarPath(40.0, -9.0, M_PI / 2, 1.4).Drive(d), tl));
+  plan.movers.push_back(
+      PathMover(BodyClass::kPerson, kPersonExtent, PlanarPath(25.0, 8.5, 0.0, 1.2).Drive(d), tl));
+  plan.building_margin_m = 12.0;
+  return plan;
+}
+
 using PlanFn = ScenarioPlan (*)(const Timeline&, uint64_t);
 
 struct ScenarioEntry {
@@ -300,6 +325,8 @@ const std::vector<ScenarioEntry>& Registry() {
       {"robot_odometry", RobotOdometryPlan,
        "camera on a ground robot with noisy 50 Hz wheel odometry and extrinsic base_from_cam"},
       {"rotation_only", RotationOnlyPlan, "camera rotating about its centre (no translation); a person and a car move"},
+      {"driving", DrivingPlan,
+       "car-mounted camera at 6 m/s down a street: a car ahead, an oncoming car, a crossing and a walking person"},
   };
   return entries;
 }
@@ -539,6 +566,7 @@ Status BuildScenario(const SimOptions& options, Scene* scene) {
                    StyleFor(m.body_class), false, m.tint);
     scene->bodies.push_back(std::move(body));
   }
+  builder.GenerateTextures(static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 4u)));
   size_t texture_bytes = 0;
   for (const auto& t : scene->textures) texture_bytes += t.total() * t.elemSize();
   MBSLAM_LOG(DEBUG) << "scenario " << scene->scenario << ": " << scene->bodies.size() << " bodies, "

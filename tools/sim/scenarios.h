@@ -17,6 +17,8 @@
 //                      camera-robot extrinsic base_from_cam; people and a car move
 //   rotation_only      camera rotating about its centre (no translation); a person and a
 //                      car move
+//   driving            smooth car-like forward motion at 6 m/s down a street: a car ahead
+//                      in the same lane, an oncoming car, pedestrians crossing and walking
 //
 // World frame: z up, ground plane z = 0, metres.
 

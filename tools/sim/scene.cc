@@ -1,9 +1,11 @@
 #include "tools/sim/scene.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <thread>
 
 namespace mbslam {
 namespace sim {
@@ -76,7 +78,8 @@ int SceneBuilder::AddTexture(const Quad& quad, const Rigid3d& world_from_body, b
     }
     if (!front_seen) {  // a token texture: it is never drawn into any image
       sample_weight_ = 0.0;
-      scene_->textures.push_back(MakeTexture(style, 16, 16, 1.0, NextSeed(), tint));
+      jobs_.push_back({style, 16, 16, 1.0, NextSeed(), tint});
+      scene_->textures.emplace_back();
       return static_cast<int>(scene_->textures.size()) - 1;
     }
     lod = std::max(1.0, distance / lod_distance_m_);
@@ -90,8 +93,27 @@ int SceneBuilder::AddTexture(const Quad& quad, const Rigid3d& world_from_body, b
   const int w = std::clamp(static_cast<int>(std::ceil(len_u / texel)), 16, max_texture_px_);
   const int h = std::clamp(static_cast<int>(std::ceil(len_v / texel)), 16, max_texture_px_);
   const double effective_texel = std::max(len_u / w, len_v / h);
-  scene_->textures.push_back(MakeTexture(style, w, h, effective_texel, NextSeed(), tint));
+  jobs_.push_back({style, w, h, effective_texel, NextSeed(), tint});
+  scene_->textures.emplace_back();
   return static_cast<int>(scene_->textures.size()) - 1;
+}
+
+void SceneBuilder::GenerateTextures(int threads) {
+  // Every texture depends only on its own job (seed included): the result is the same
+  // for any number of threads.
+  const size_t first = scene_->textures.size() - jobs_.size();
+  std::atomic<size_t> next{0};
+  auto work = [&]() {
+    for (size_t i = next++; i < jobs_.size(); i = next++) {
+      const TextureJob& j = jobs_[i];
+      scene_->textures[first + i] = MakeTexture(j.style, j.width, j.height, j.texel_m, j.seed, j.tint);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  jobs_.clear();
 }
 
 void SceneBuilder::AddBox(SceneBody* body, const Rigid3d& world_from_body,

@@ -91,7 +91,19 @@ class SceneBuilder {
 
   uint64_t NextSeed();
 
+  // Textures are generated here, not when geometry is added: call once after adding
+  // everything (uses `threads` threads, joined before returning).
+  void GenerateTextures(int threads);
+
  private:
+  struct TextureJob {
+    TextureStyle style;
+    int width;
+    int height;
+    double texel_m;
+    uint64_t seed;
+    cv::Scalar tint;
+  };
   int AddTexture(const Quad& quad, const Rigid3d& world_from_body, bool is_static, TextureStyle style,
                  const cv::Scalar& tint, double texel_factor);
   double DistanceToCamera(const Eigen::Vector3d& point) const;
@@ -103,6 +115,7 @@ class SceneBuilder {
   int max_texture_px_;
   uint64_t seed_;
   double sample_weight_ = 1.0;  // of the quad whose texture was made last
+  std::vector<TextureJob> jobs_;  // textures to generate (the last jobs_.size() of the scene's)
 };
 
 // Result of casting a ray into the scene.

@@ -7,10 +7,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <thread>
 
 #include "common/config/options_yaml.h"
 #include "common/lcm/lcm_log.h"
 #include "common/util/atomic_file.h"
+#include "common/util/bounded_queue.h"
 #include "common/util/logging.h"
 #include "common/util/time.h"
 #include "mbslam/camera_calibration_t.hpp"
@@ -134,9 +136,9 @@ mbslam::odometry_t MakeOdometryMessage(const OdometrySample& o) {
   return msg;
 }
 
-Status WriteImage(const std::string& path, const cv::Mat& img) {
+Status WriteImage(const std::string& path, const cv::Mat& img, const std::vector<int>& params = {}) {
   try {
-    if (!cv::imwrite(path, img)) return Status::Error("cannot write " + path);
+    if (!cv::imwrite(path, img, params)) return Status::Error("cannot write " + path);
   } catch (const cv::Exception& e) {
     return Status::Error("cannot write " + path + ": " + e.what());
   }
@@ -149,6 +151,70 @@ std::string Vec3Yaml(const Eigen::Vector3d& v) {
   out << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
   return out.str();
 }
+
+// Writes images/, masks/, depth/ of frame k.
+Status WriteFrameFiles(const fs::path& root, const SequenceWriterOptions& options, int k, const cv::Mat& image,
+                       const cv::Mat& mask, const cv::Mat& depth) {
+  MBSLAM_RETURN_IF_ERROR(WriteImage((root / "images" / FrameName(k, "png")).string(), image));
+  if (options.write_masks) {
+    MBSLAM_RETURN_IF_ERROR(WriteImage((root / "masks" / FrameName(k, "png")).string(), mask));
+  }
+  if (!options.write_depth) return Status::Ok();
+  if (options.depth_format == "exr") {
+    const int compression = options.exr_compression == "none"  ? cv::IMWRITE_EXR_COMPRESSION_NO
+                            : options.exr_compression == "zip" ? cv::IMWRITE_EXR_COMPRESSION_ZIP
+                                                               : cv::IMWRITE_EXR_COMPRESSION_RLE;
+    return WriteImage((root / "depth" / FrameName(k, "exr")).string(), depth,
+                      {cv::IMWRITE_EXR_TYPE, cv::IMWRITE_EXR_TYPE_FLOAT, cv::IMWRITE_EXR_COMPRESSION, compression});
+  }
+  cv::Mat mm(depth.size(), CV_16UC1);
+  for (int r = 0; r < mm.rows; ++r) {
+    const float* d = depth.ptr<float>(r);
+    uint16_t* out = mm.ptr<uint16_t>(r);
+    for (int c = 0; c < mm.cols; ++c) {
+      const double v = std::round(d[c] * 1000.0);
+      out[c] = (v > 0.0 && v <= 65535.0) ? static_cast<uint16_t>(v) : 0;
+    }
+  }
+  return WriteImage((root / "depth" / FrameName(k, "png")).string(), mm);
+}
+
+// Writes frame files on a thread of its own while the next frame renders. Joined by
+// Finish() or the destructor.
+class FileWriterThread {
+ public:
+  FileWriterThread(fs::path root, const SequenceWriterOptions& options)
+      : root_(std::move(root)), options_(options), queue_(4, QueueFullPolicy::kBlock), thread_([this] { Run(); }) {}
+  ~FileWriterThread() { Finish(); }
+
+  bool Push(int k, cv::Mat image, cv::Mat mask, cv::Mat depth) {
+    return queue_.Push(Job{k, std::move(image), std::move(mask), std::move(depth)});
+  }
+  // Waits for every queued frame; the first error, if any.
+  Status Finish() {
+    queue_.Shutdown();
+    if (thread_.joinable()) thread_.join();
+    return status_;
+  }
+
+ private:
+  struct Job {
+    int k;
+    cv::Mat image, mask, depth;
+  };
+  void Run() {
+    while (auto job = queue_.Pop()) {
+      if (!status_.ok()) continue;  // drain after an error
+      status_ = WriteFrameFiles(root_, options_, job->k, job->image, job->mask, job->depth);
+    }
+  }
+
+  const fs::path root_;
+  const SequenceWriterOptions options_;
+  BoundedQueue<Job> queue_;
+  Status status_;  // written by the thread only, read after join
+  std::thread thread_;
+};
 
 Status MakeDirs(const std::string& dir) {
   std::error_code ec;
@@ -178,6 +244,8 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
     if (!log) return st;
   }
 
+  std::unique_ptr<FileWriterThread> files;
+  if (options.write_files) files = std::make_unique<FileWriterThread>(root, options);
   const std::vector<int> ids = sim->MovingBodyIds();
   summary->frames_visible.assign(ids.size(), 0);
   eval::Trajectory cam_traj;
@@ -205,27 +273,11 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
     cam_traj.push_back({frame.utime, frame.world_from_cam});
     timestamps += std::to_string(k) + " " + std::to_string(frame.utime) + "\n";
 
-    if (options.write_files) {
-      MBSLAM_RETURN_IF_ERROR(WriteImage((root / "images" / FrameName(k, "png")).string(),
-                                        options.color_images ? frame.image_bgr : frame.image_gray));
-      if (options.write_masks) {
-        MBSLAM_RETURN_IF_ERROR(WriteImage((root / "masks" / FrameName(k, "png")).string(), frame.mask));
-      }
-      if (options.write_depth) {
-        if (options.depth_format == "exr") {
-          MBSLAM_RETURN_IF_ERROR(WriteImage((root / "depth" / FrameName(k, "exr")).string(), frame.depth));
-        } else {
-          cv::Mat mm(frame.depth.size(), CV_16UC1);
-          for (int r = 0; r < mm.rows; ++r) {
-            const float* d = frame.depth.ptr<float>(r);
-            uint16_t* out = mm.ptr<uint16_t>(r);
-            for (int c = 0; c < mm.cols; ++c) {
-              const double v = std::round(d[c] * 1000.0);
-              out[c] = (v > 0.0 && v <= 65535.0) ? static_cast<uint16_t>(v) : 0;
-            }
-          }
-          MBSLAM_RETURN_IF_ERROR(WriteImage((root / "depth" / FrameName(k, "png")).string(), mm));
-        }
+    if (files) {
+      // The writer thread shares the frame's buffers; RenderFrame allocates new ones for
+      // the next frame, so nothing is written into them again.
+      if (!files->Push(k, options.color_images ? frame.image_bgr : frame.image_gray, frame.mask, frame.depth)) {
+        return files->Finish();
       }
     }
     if (log) {
@@ -256,6 +308,7 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
     summary->lcm_events = log->events_written();
     log.reset();
   }
+  if (files) MBSLAM_RETURN_IF_ERROR(files->Finish());
   summary->odometry_samples = static_cast<int>(odometry.size());
   summary->mean_moving_fraction = summary->frames > 0 ? fraction_sum / summary->frames : 0.0;
 

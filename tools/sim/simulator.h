@@ -100,7 +100,8 @@ class Simulator {
   // Moving bodies' ids in ascending order.
   std::vector<int> MovingBodyIds() const;
 
-  // Renders frame k (0 <= k < num_frames).
+  // Renders frame k (0 <= k < num_frames). The frame's images are (re)allocated: buffers
+  // shared with an earlier frame's cv::Mat copies are never written into.
   Status RenderFrame(int k, SimFrame* frame, const RenderRequest& request = RenderRequest());
   // Poses, velocities and body descriptions of frame k, no pixels.
   Status FrameTruth(int k, SimFrame* frame) const;

@@ -32,7 +32,7 @@ TEST_P(ScenarioGroundTruth, ProjectionsMasksAndDepthAgree) {
   options.pixel_stride = 3;
   GtCheckReport report;
   SimFrame frame;
-  const int n = 6;
+  const int n = 4;
   for (int i = 0; i < n; ++i) {
     const int k = i * (sim->num_frames() - 1) / (n - 1);
     ASSERT_TRUE(sim->RenderFrame(k, &frame, RenderRequest{false, true}).ok());
