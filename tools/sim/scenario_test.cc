@@ -7,6 +7,8 @@
 #include <opencv2/video/tracking.hpp>
 
 #include <algorithm>
+#include <cstdlib>
+#include <fstream>
 #include <map>
 #include <memory>
 
@@ -58,6 +60,17 @@ TEST(Scenarios, AllRegistered) {
                         "rotation_only"}) {
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
     EXPECT_FALSE(ScenarioDescription(n).empty());
+  }
+}
+
+// The build generates a fixture for every scenario (tools/sim/CMakeLists.txt).
+TEST(Scenarios, EveryScenarioHasABuildFixture) {
+  const char* bin = std::getenv("MBSLAM_BIN_DIR");
+  if (!bin) GTEST_SKIP() << "MBSLAM_BIN_DIR not set (run through ctest)";
+  const std::string fixtures = std::string(bin) + "/../fixtures/sim/";
+  for (const auto& name : ScenarioNames()) {
+    EXPECT_TRUE(std::ifstream(fixtures + name + "/timestamps.txt").good()) << "no fixture for " << name;
+    EXPECT_TRUE(std::ifstream(fixtures + name + "/sequence.lcmlog").good()) << "no fixture log for " << name;
   }
 }
 

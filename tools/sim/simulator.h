@@ -13,8 +13,14 @@
 //   status = sim->RenderFrame(7, &frame);   // image, mask, depth, poses of frame 7
 //
 // Every frame is a pure function of (options, frame index): frames can be rendered in any
-// order, and the same options give the same pixels. Conventions: world z up, ground
+// order, and the same options give the same pixels (on the same machine: llvmpipe's
+// results may differ in the last bit between CPUs). Conventions: world z up, ground
 // z = 0, metres; poses world_from_x; time int64 µs; body id 0 = static world.
+//
+// A Simulator owns an OSMesa GL context: use it from one thread at a time, and do not
+// keep it in static storage (a context destroyed during static destruction, after the
+// driver has shut down, crashes). Creation builds the textures (a few seconds at
+// 640x480, less for smaller images).
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -89,6 +95,7 @@ class Simulator {
 
   const SimOptions& options() const { return options_; }
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }
+  // Geometry and trajectories (the texture images are released once uploaded).
   const Scene& scene() const { return scene_; }
   int num_frames() const { return options_.num_frames; }
   int64_t FrameUtime(int k) const { return options_.FrameUtime(k); }
