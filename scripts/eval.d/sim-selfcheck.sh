@@ -119,5 +119,10 @@ for args in "--wrong 1" "--wrong 9" "--split 6" "--merge" "--wrong 4 --split 3";
   j=$((j + 1))
 done
 
+# Pass: sub-pixel reprojection and label errors within 0.5 px, no mask / depth mismatch
+# away from silhouettes, and the known answers recovered to numerical precision.
+pass=$(awk -v r="$reproj_max" -v l="$label_max" -v lf="$label_failures" -v pm="$pixel_mismatch_off_edge" \
+  -v a="$ate_err" -v m="$mis_err" \
+  'BEGIN { print (r <= 0.5 && l <= 0.5 && lf == 0 && pm == 0 && a < 1e-6 && m < 1e-12) ? "true" : "false" }')
 echo "summary: gt reprojection max $reproj_max px, label max $label_max px ($label_failures failures), ATE known-answer error $ate_err m, misclassification known-answer error $mis_err"
-echo "{\"gt_reprojection_max_px\": $reproj_max, \"ate_known_answer_error\": $ate_err, \"misclassification_known_answer_error\": $mis_err, \"gt_label_max_px\": $label_max, \"gt_label_failures\": $label_failures, \"gt_pixel_mismatches_off_silhouette\": $pixel_mismatch_off_edge, \"gt_depth_max_rel_error\": $depth_rel_max, \"gt_samples_checked\": $samples, \"rpe_self_m\": $rpe_self, \"size\": \"$size\", \"per_scenario_reprojection_max_px\": {${scenario_json%, }}}"
+echo "{\"gt_reprojection_max_px\": $reproj_max, \"ate_known_answer_error\": $ate_err, \"misclassification_known_answer_error\": $mis_err, \"gt_label_max_px\": $label_max, \"gt_label_failures\": $label_failures, \"gt_pixel_mismatches_off_silhouette\": $pixel_mismatch_off_edge, \"gt_depth_max_rel_error\": $depth_rel_max, \"gt_samples_checked\": $samples, \"rpe_self_m\": $rpe_self, \"size\": \"$size\", \"per_scenario_reprojection_max_px\": {${scenario_json%, }}, \"pass\": $pass}"

@@ -278,7 +278,10 @@ int RunSeg(const Args& args) {
     std::vector<double> all;
     int missing = 0;
     Json per = Json::Object();
+    const bool include_dancing = args.Has("include-dancing");
     for (const auto& set : sets) {
+      // Hopkins 155 is scored without its extra 'dancing' sequence (data README).
+      if (set.name == "dancing" && !include_dancing) continue;
       const std::string pred_path = (fs::path(args.Get("pred-dir")) / (set.name + suffix)).string();
       std::vector<int> pred;
       if (!eval::ReadLabelFile(pred_path, &pred).ok() || pred.size() != set.labels.size()) {
@@ -546,8 +549,10 @@ int RunDatasets(const Args& args) {
     std::string text = std::to_string(sets.size()) + " sequences (";
     Json info = Json::Object();
     info.Set("sequences", sets.size());
+    bool first = true;
     for (const auto& g : by_groups) {
-      text += std::to_string(g.second) + " with " + std::to_string(g.first) + " groups, ";
+      text += (first ? "" : ", ") + std::to_string(g.second) + " with " + std::to_string(g.first) + " groups";
+      first = false;
       info.Set(std::to_string(g.first) + "_groups", g.second);
     }
     report("hopkins155", text + ")", info);
@@ -598,7 +603,7 @@ void Usage() {
            [--align sim3|se3|none] [--max-dt-us N] [--rpe-delta N | --rpe-delta-us N] [--plot OUT.png] [--title T]
   seg      track misclassification (Hungarian matching)
            --pred LABELS --truth LABELS|X.tracks.txt
-           --pred-dir DIR [--tracks-dir DIR (default: Hopkins 155)] [--pred-suffix .labels.txt]
+           --pred-dir DIR [--tracks-dir DIR (default: Hopkins 155)] [--pred-suffix .labels.txt] [--include-dancing]
   masks    region IoU and moving-feature precision / recall
            --pred-dir DIR --gt-dir DIR [--features FILE ("stem u v moving" per line)]
   camvid   where features labelled moving fall in CamVid's classes (false detections on static classes)
