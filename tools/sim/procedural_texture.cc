@@ -43,6 +43,26 @@ cv::Scalar Vary(Rng* rng, const cv::Scalar& base, double lo, double hi, double j
 
 cv::Scalar Gray(double v) { return cv::Scalar(v, v, v); }
 
+// One of a few natural base colours (BGR), brightness-varied, with a slight hue jitter.
+cv::Scalar FromPalette(Rng* rng, const std::vector<cv::Scalar>& palette, double lo, double hi) {
+  return Vary(rng, palette[static_cast<size_t>(rng->Int(0, static_cast<int>(palette.size()) - 1))], lo, hi, 0.015);
+}
+
+const std::vector<cv::Scalar> kStonePalette = {
+    {0.55, 0.57, 0.58},  // grey granite
+    {0.45, 0.55, 0.65},  // beige sandstone
+    {0.35, 0.40, 0.60},  // red brick paver
+    {0.50, 0.50, 0.48},  // concrete
+};
+const std::vector<cv::Scalar> kFacadePalette = {
+    {0.62, 0.70, 0.78},  // cream plaster
+    {0.55, 0.56, 0.57},  // grey render
+    {0.30, 0.35, 0.62},  // brick
+    {0.78, 0.80, 0.80},  // white
+    {0.45, 0.65, 0.75},  // ochre
+    {0.60, 0.55, 0.45},  // blue-grey
+};
+
 cv::Scalar RandomSaturated(Rng* rng) {
   // A random fairly saturated colour, built in HSV.
   cv::Mat hsv(1, 1, CV_32FC3, cv::Scalar(rng->Uniform(0.0, 360.0), rng->Uniform(0.4, 0.9),
@@ -152,7 +172,7 @@ void DrawVoronoiStones(cv::Mat* img, Rng* rng, double stone_px, const cv::Scalar
   for (const auto& f : facets) {
     std::vector<cv::Point> poly;
     for (const auto& p : f) poly.emplace_back(cvRound(p.x), cvRound(p.y));
-    cv::fillConvexPoly(*img, poly, Vary(rng, base, 0.6, 1.35, 0.04));
+    cv::fillConvexPoly(*img, poly, Vary(rng, base, 0.6, 1.35, 0.015));
     cv::polylines(*img, std::vector<std::vector<cv::Point>>{poly}, true,
                   base * rng->Uniform(0.25, 0.45), joint);
   }
@@ -259,19 +279,19 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
       break;
     }
     case TextureStyle::kPaving: {
-      const cv::Scalar base = Vary(&rng, cv::Scalar(0.5, 0.55, 0.6), 0.8, 1.2, 0.05);
+      const cv::Scalar base = FromPalette(&rng, kStonePalette, 0.8, 1.2);
       img.setTo(base);
       DrawVoronoiStones(&img, &rng, px(rng.Uniform(0.25, 0.45)), base, std::max(1.0, px(0.012)));
       Modulate(&img, low, 0.15);
       DrawBlobs(&img, &rng, CountFor(img, 3000), 1.0, std::max(1.5, px(0.02)),
-                [&](Rng* r) { return Vary(r, base, 0.3, 1.5, 0.03); });
+                [&](Rng* r) { return Vary(r, base, 0.3, 1.5, 0.01); });
       DrawBlobs(&img, &rng, CountFor(img, 15), px(0.2), px(1.0),
-                [&](Rng* r) { return Vary(r, base, 0.5, 0.8, 0.02); });  // stains
+                [&](Rng* r) { return Vary(r, base, 0.5, 0.8, 0.01); });  // stains
       Modulate(&img, grain, 0.2);
       break;
     }
     case TextureStyle::kFacade: {
-      const cv::Scalar base = have_tint ? Clamp01(tint) : Vary(&rng, cv::Scalar(0.55, 0.65, 0.75), 0.7, 1.2, 0.08);
+      const cv::Scalar base = have_tint ? Clamp01(tint) : FromPalette(&rng, kFacadePalette, 0.8, 1.15);
       img.setTo(base);
       Modulate(&img, low, 0.15);
       // Irregular windows: floors of varying height, windows of varying width and spacing.
