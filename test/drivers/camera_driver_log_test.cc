@@ -294,6 +294,59 @@ TEST(CameraDriverLog, BadInputsGiveDistinctCodes) {
   EXPECT_EQ(ReadLog(dir + "/d.lcmlog").images.size(), 1u);
 }
 
+// The simulator's own fixtures (tools/sim builds them into <build>/fixtures/sim/), when
+// present: camera_driver on the folder must reproduce the simulator's sequence.lcmlog.
+TEST(CameraDriverLog, SimulatorFixturesMatchTheSimulatorsOwnLog) {
+  const std::string fixtures = fs::path(BinPath("camera_driver")).parent_path().parent_path().string() +
+                               "/fixtures/sim";
+  int checked = 0;
+  for (const char* scenario : {"crossing", "robot_odometry", "multi"}) {
+    const std::string dir = fixtures + "/" + scenario;
+    if (!fs::exists(dir + "/timestamps.txt") || !fs::exists(dir + "/sequence.lcmlog")) continue;
+    const std::string log = MakeTempDir("it_simfix") + "/mine.lcmlog";
+    const auto r = RunDriver({"--source", "sequence", "--input", dir, "--log", log});
+    ASSERT_EQ(r.exit_code, kExitOk) << r.err;
+    const DecodedLog mine = ReadLog(log);
+    std::vector<LcmLogEvent> events;
+    ASSERT_TRUE(ReadLcmLog(dir + "/sequence.lcmlog", &events).ok());
+    std::vector<mbslam::image_t> theirs;
+    std::vector<mbslam::ground_truth_t> their_truth;
+    for (const LcmLogEvent& e : events) {
+      if (e.channel == "CAMERA_IMAGE") {
+        mbslam::image_t m{};
+        ASSERT_TRUE(DecodeLcmMessage(e.data.data(), e.data.size(), &m).ok());
+        theirs.push_back(m);
+      } else if (e.channel == "GROUND_TRUTH") {
+        mbslam::ground_truth_t m{};
+        ASSERT_TRUE(DecodeLcmMessage(e.data.data(), e.data.size(), &m).ok());
+        their_truth.push_back(m);
+      }
+    }
+    ASSERT_EQ(mine.images.size(), theirs.size()) << scenario;
+    ASSERT_EQ(mine.truth.size(), their_truth.size()) << scenario;
+    for (size_t i = 0; i < theirs.size(); ++i) {
+      EXPECT_EQ(mine.images[i].utime, theirs[i].utime);
+      EXPECT_EQ(mine.images[i].seq, theirs[i].seq);
+      if (theirs[i].encoding == mine.images[i].encoding) {
+        EXPECT_EQ(mine.images[i].data, theirs[i].data);
+      }
+      EXPECT_TRUE(Identical(Decode(mine.images[i]), Decode(theirs[i]))) << scenario << " " << i;
+      EXPECT_EQ(mine.truth[i].source, their_truth[i].source);
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(mine.truth[i].cam_position[k], their_truth[i].cam_position[k], 1e-6);
+      ASSERT_EQ(mine.truth[i].num_bodies, their_truth[i].num_bodies) << scenario << " " << i;
+      for (size_t b = 0; b < mine.truth[i].bodies.size(); ++b) {
+        EXPECT_EQ(mine.truth[i].bodies[b].id, their_truth[i].bodies[b].id);
+        EXPECT_EQ(mine.truth[i].bodies[b].visible, their_truth[i].bodies[b].visible) << scenario << " " << i;
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_NEAR(mine.truth[i].bodies[b].position[k], their_truth[i].bodies[b].position[k], 1e-6);
+        }
+      }
+    }
+    ++checked;
+  }
+  if (checked == 0) GTEST_SKIP() << "no simulator fixtures in " << fixtures;
+}
+
 TEST(CameraDriverLog, SigtermDuringPacedPlaybackExitsCleanly) {
   const std::string dir = MakeTempDir("it_sigterm");
   for (int i = 0; i < 20; ++i) cv::imwrite(dir + "/" + std::to_string(i) + ".png", MakeTestImage(8, 8, 1, i));
