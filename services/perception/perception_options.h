@@ -48,6 +48,7 @@ struct PerceptionOptions {
   SegmentationOptions segmentation;
   PersonDetectorOptions person;
   OdometryOptions odometry;
+  SlamOptions slam;
 
   CoreOptions core() const {
     CoreOptions c;
@@ -56,6 +57,9 @@ struct PerceptionOptions {
     c.segmentation = segmentation;
     c.person = person;
     c.odometry = odometry;
+    c.slam = slam;
+    // Lockstep replays must be deterministic: bundle adjustment runs inline there.
+    if (pipeline.lockstep()) c.slam.background_ba = false;
     return c;
   }
 
@@ -69,6 +73,7 @@ struct PerceptionOptions {
     MBSLAM_CHECK_OPTION_SECTION(segmentation);
     MBSLAM_CHECK_OPTION_SECTION(person);
     MBSLAM_CHECK_OPTION_SECTION(odometry);
+    MBSLAM_CHECK_OPTION_SECTION(slam);
     return true;
   }
   template <typename V>
@@ -82,6 +87,7 @@ struct PerceptionOptions {
     v("segmentation", &segmentation, "multibody motion segmentation (thesis ch. 3)");
     v("person", &person, "person detection in moving regions (thesis sec. 3.9.4)");
     v("odometry", &odometry, "ego-motion from wheel odometry (thesis sec. 3.8)");
+    v("slam", &slam, "static-world keyframe SLAM (thesis ch. 4)");
   }
 };
 

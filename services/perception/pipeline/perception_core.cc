@@ -15,17 +15,21 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
       preprocess_timer_(timers->Get("preprocess")),
       tracking_timer_(timers->Get("tracking")),
       segmentation_timer_(timers->Get("segmentation")),
+      slam_timer_(timers->Get("slam_tracking")),
+      mapping_timer_(timers->Get("slam_mapping")),
       odometry_(options.preprocess.max_odometry_gap_us,
                 static_cast<size_t>(options.preprocess.max_odometry_samples)),
       tracker_(options.tracking),
       segmenter_(options.segmentation),
-      person_detector_(options.person) {
+      person_detector_(options.person),
+      slam_(options.slam) {
   const auto& q = options.odometry.base_from_cam_rotation;
   const auto& t = options.odometry.base_from_cam_translation;
   base_from_cam_ = Rigid3d(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), Eigen::Vector3d(t[0], t[1], t[2]));
 }
 
 void PerceptionCore::Reset() {
+  slam_.Reset();
   tracker_.Reset();
   segmenter_.Reset();
   odometry_.Clear();
@@ -73,6 +77,62 @@ std::optional<RelativeMotion> PerceptionCore::OdometryMotion(int64_t ref_frame,
   return m;
 }
 
+std::optional<Rigid3d> PerceptionCore::OdometryCameraPose(int64_t utime) const {
+  Rigid3d odom_from_base;
+  if (odometry_.Interpolate(utime, &odom_from_base) != InterpolationResult::kOk) return std::nullopt;
+  return odom_from_base * base_from_cam_;
+}
+
+void PerceptionCore::FillCameraPose(const SlamPose& pose, CameraPoseOutput* out) const {
+  switch (pose.state) {
+    case SlamState::kNotInitialized: out->tracking_state = TrackingState::kNotInitialized; break;
+    case SlamState::kInitializing:
+    case SlamState::kConfirming: out->tracking_state = TrackingState::kInitializing; break;
+    case SlamState::kTracking:
+      out->tracking_state = pose.relocalized ? TrackingState::kRelocalized : TrackingState::kOk;
+      break;
+    case SlamState::kLost: out->tracking_state = TrackingState::kLost; break;
+  }
+  if (!pose.valid) {
+    if (out->tracking_state == TrackingState::kOk) out->tracking_state = TrackingState::kInitializing;
+    return;
+  }
+  out->world_from_cam = pose.cam_from_world.Inverse();
+  // Left perturbation of world_from_cam = T^-1: Exp(-Ad(T^-1) xi) T^-1.
+  const Matrix6d ad = out->world_from_cam.Adjoint();
+  out->covariance = ad * pose.covariance * ad.transpose();
+  out->scale_state = pose.metric ? ScaleState::kMetric : ScaleState::kUpToScale;
+  out->scale_to_metric = pose.scale_to_metric;
+  out->num_inliers = pose.num_inliers;
+  out->num_keyframes = static_cast<int>(slam_.map().num_keyframes());
+}
+
+MapOutput PerceptionCore::BuildMapOutput(int64_t utime) const {
+  MapOutput m;
+  m.utime = utime;
+  m.scale_state = slam_.metric() ? ScaleState::kMetric : ScaleState::kUpToScale;
+  const Map& map = slam_.map();
+  std::vector<int64_t> ids;
+  ids.reserve(map.num_points());
+  for (const auto& kv : map.points()) ids.push_back(kv.first);
+  std::sort(ids.begin(), ids.end());  // deterministic order
+  for (int64_t id : ids) {
+    const MapPoint& p = *map.point(id);
+    m.point_ids.push_back(id);
+    m.points.push_back(p.position.cast<float>());
+    m.colors.push_back({p.gray, p.gray, p.gray});
+  }
+  for (const auto& [id, k] : map.keyframes()) {
+    KeyframeOutput kf;
+    kf.id = id;
+    kf.utime = k.utime;
+    kf.world_from_cam = k.cam_from_world.Inverse();
+    kf.num_observations = static_cast<int>(k.point_ids.size());
+    m.keyframes.push_back(kf);
+  }
+  return m;
+}
+
 FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   if (frame.timeline_reset) {
     MBSLAM_LOG(WARNING) << "image time went back for good at " << frame.utime << ": starting over";
@@ -108,27 +168,64 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     tracker_.TrackFrame(pyramid_, frame_index_, hints);
   }
 
+  // SLAM, step 1: the camera pose against the static map, with the previous labels.
+  const CameraIntrinsics& intrinsics = *frame.intrinsics;
+  SlamFrame slam_frame;
+  slam_frame.frame_index = frame_index_;
+  slam_frame.utime = frame.utime;
+  slam_frame.focal_px = 0.5 * (intrinsics.fx + intrinsics.fy);
+  slam_frame.mean_gray = static_cast<uint8_t>(cv::mean(frame.gray)[0]);
+  if (options_.slam.use_odometry) slam_frame.odom_from_cam = OdometryCameraPose(frame.utime);
+  for (const Track& t : tracker_.tracks()) {
+    if (!t.active()) continue;
+    SlamObservation o;
+    o.track_id = t.id;
+    o.uv = t.uv.cast<double>();
+    o.xy = intrinsics.PixelToNormalized(o.uv);
+    o.body_id = t.body_id;
+    o.is_new = t.is_new;
+    slam_frame.observations.push_back(o);
+  }
+  for (const TrackingHints::Hull& h : occluders_) {
+    std::vector<Eigen::Vector2f> xy;
+    for (const Eigen::Vector2f& p : h.points) xy.push_back(intrinsics.PixelToNormalized(p.cast<double>()).cast<float>());
+    slam_frame.moving_hulls_xy.push_back(std::move(xy));
+  }
+  SlamPose slam_pose;
+  {
+    ScopedStageTimer timer(slam_timer_);
+    slam_pose = slam_.TrackPose(slam_frame);
+  }
+
   // Segmentation on the active tracks.
   SegmentationResult seg;
   {
     ScopedStageTimer timer(segmentation_timer_);
-    const CameraIntrinsics& K = *frame.intrinsics;
+    const CameraIntrinsics& K = intrinsics;
     SegmenterInput in;
     in.frame_index = frame_index_;
     in.width = frame.gray.cols;
     in.height = frame.gray.rows;
     in.focal_px = 0.5 * (K.fx + K.fy);
     in.K = K.K();
-    for (const Track& t : tracker_.tracks()) {
-      if (!t.active()) continue;
+    for (const SlamObservation& so : slam_frame.observations) {
       TrackObservation o;
-      o.id = t.id;
-      o.uv = t.uv.cast<double>();
-      o.xy = K.PixelToNormalized(o.uv);
+      o.id = so.track_id;
+      o.uv = so.uv;
+      o.xy = so.xy;
       in.observations.push_back(o);
     }
-    in.world_motion = [this](int64_t r, int64_t n) { return OdometryMotion(r, n); };
-    if (options_.odometry.use_for_ego_motion && !odometry_.empty()) {
+    // World motion: SLAM's poses when the map tracks (with its depth bounds), else
+    // odometry, else the segmenter's own two-view estimate.
+    in.world_motion = [this](int64_t r, int64_t n) -> std::optional<RelativeMotion> {
+      if (auto m = slam_.RelativeMotionBetween(r, n)) return m;
+      return OdometryMotion(r, n);
+    };
+    if (slam_.initialized()) {
+      in.depth_bound = [this](int64_t id, const Eigen::Vector2d& xy, int64_t r) {
+        return slam_.DepthBoundFor(id, xy, r);
+      };
+    } else if (options_.odometry.use_for_ego_motion && !odometry_.empty()) {
       const double zmin = options_.odometry.min_depth_m;
       const double zmax = options_.odometry.max_depth_m > 0.0 ? options_.odometry.max_depth_m
                                                               : std::numeric_limits<double>::infinity();
@@ -149,7 +246,23 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
 
   // Labels back onto the tracks (feedback to the tracker's occlusion handling).
   std::unordered_map<int64_t, const TrackLabel*> label_of;
-  for (const TrackLabel& l : seg.labels) label_of[l.id] = &l;
+  std::unordered_map<int64_t, int> body_of;
+  for (const TrackLabel& l : seg.labels) {
+    label_of[l.id] = &l;
+    body_of[l.id] = l.body_id;
+  }
+  // SLAM, step 2: the labels update the map (moving tracks leave it), keyframes, BA.
+  SlamMapUpdate map_update;
+  {
+    ScopedStageTimer timer(mapping_timer_);
+    map_update = slam_.UpdateMap(slam_frame, body_of);
+  }
+  FillCameraPose(slam_pose, &result.camera_pose);
+  if (slam_.map().num_keyframes() > 0 &&
+      (map_update.new_keyframe || frame_index_ - last_map_publish_frame_ >= options_.map_publish_every_frames)) {
+    result.map = BuildMapOutput(frame.utime);
+    last_map_publish_frame_ = frame_index_;
+  }
   for (Track& t : tracker_.tracks()) {
     auto it = label_of.find(t.id);
     if (it == label_of.end()) continue;
@@ -205,7 +318,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     o.body_id = t.body_id;
     o.p_static = t.p_static;
     o.occluded = !t.active();
-    o.has_3d = t.has_3d;
+    o.has_3d = slam_.HasPoint(t.id);
     o.is_new = t.is_new;
     auto it = label_of.find(t.id);
     if (it != label_of.end()) {
@@ -214,7 +327,6 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     }
     result.tracks.push_back(o);
   }
-  if (seg.initialized) result.camera_pose.tracking_state = TrackingState::kInitializing;
   return result;
 }
 

@@ -20,6 +20,7 @@
 #include "services/perception/pipeline/stage_timers.h"
 #include "services/perception/segmentation/motion_segmenter.h"
 #include "services/perception/segmentation/person_detector.h"
+#include "services/perception/slam/slam_system.h"
 #include "services/perception/tracking/feature_tracker.h"
 
 namespace mbslam {
@@ -91,6 +92,8 @@ struct CoreOptions {
   SegmentationOptions segmentation;
   PersonDetectorOptions person;
   OdometryOptions odometry;
+  SlamOptions slam;
+  int map_publish_every_frames = 15;  // PERCEPTION_MAP at most this often, and at every keyframe
 };
 
 class PerceptionCore : public FrameProcessor {
@@ -101,9 +104,14 @@ class PerceptionCore : public FrameProcessor {
   FrameResult ProcessFrame(const ImageFrame& frame) override;
 
   const PoseBuffer& odometry() const { return odometry_; }
+  const SlamSystem& slam() const { return slam_; }
+  void Finish() override { slam_.Flush(); }
 
  private:
   std::optional<RelativeMotion> OdometryMotion(int64_t ref_frame, int64_t cur_frame) const;
+  std::optional<Rigid3d> OdometryCameraPose(int64_t utime) const;
+  void FillCameraPose(const SlamPose& pose, CameraPoseOutput* out) const;
+  MapOutput BuildMapOutput(int64_t utime) const;
   void Reset();
 
   const CoreOptions options_;
@@ -111,11 +119,15 @@ class PerceptionCore : public FrameProcessor {
   TimingStats* preprocess_timer_;
   TimingStats* tracking_timer_;
   TimingStats* segmentation_timer_;
+  TimingStats* slam_timer_;
+  TimingStats* mapping_timer_;
   PoseBuffer odometry_;
   Rigid3d base_from_cam_;
   FeatureTracker tracker_;
   MotionSegmenter segmenter_;
   PersonDetector person_detector_;
+  SlamSystem slam_;
+  int64_t last_map_publish_frame_ = -1000000;
   std::vector<cv::Mat> pyramid_;
   std::map<int64_t, int64_t> frame_utime_;   // frame index -> image time (recent frames)
   std::vector<TrackingHints::Hull> occluders_;  // moving objects' hulls predicted for the next image

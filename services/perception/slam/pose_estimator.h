@@ -1,0 +1,75 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_SLAM_POSE_ESTIMATOR_H_
+#define MBSLAM_SERVICES_PERCEPTION_SLAM_POSE_ESTIMATOR_H_
+
+// Camera resection against a body's map: EPnP inside RANSAC (also the planar-object
+// initialisation of thesis sec. 4.4), refined by motion-only optimisation (robust
+// Gauss-Newton on the reprojection errors with the analytic Jacobian), with the pose
+// covariance that the segmentation's epipolar envelope needs.
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/config/options.h"
+#include "services/perception/geometry/rigid3.h"
+
+namespace mbslam {
+
+struct PoseEstimatorOptions {
+  double ransac_threshold_px = 3.0;  // RANSAC inlier threshold (px)
+  int ransac_iterations = 100;       // EPnP RANSAC iterations (count)
+  double huber_px = 1.5;             // Huber threshold of the refinement (px)
+  double inlier_px = 3.0;            // final inliers: reprojection error below (px)
+  int refine_iterations = 10;        // Gauss-Newton iterations (count)
+  double sigma_px = 1.0;             // measurement noise for the covariance (px)
+  double prior_inlier_ratio = 0.7;   // with a prior pose explaining this share, RANSAC is skipped
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION_GT(ransac_threshold_px, 0.0);
+    MBSLAM_CHECK_OPTION_GT(ransac_iterations, 0);
+    MBSLAM_CHECK_OPTION_GT(huber_px, 0.0);
+    MBSLAM_CHECK_OPTION_GT(inlier_px, 0.0);
+    MBSLAM_CHECK_OPTION_GT(refine_iterations, 0);
+    MBSLAM_CHECK_OPTION_GT(sigma_px, 0.0);
+    MBSLAM_CHECK_OPTION(prior_inlier_ratio > 0.0 && prior_inlier_ratio <= 1.0);
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("ransac_threshold_px", &ransac_threshold_px, "EPnP RANSAC inlier threshold (px)");
+    v("ransac_iterations", &ransac_iterations, "EPnP RANSAC iterations (count)");
+    v("huber_px", &huber_px, "Huber threshold of the motion-only refinement (px)");
+    v("inlier_px", &inlier_px, "final inlier threshold (px)");
+    v("refine_iterations", &refine_iterations, "Gauss-Newton iterations (count)");
+    v("sigma_px", &sigma_px, "measurement noise for the pose covariance (px)");
+    v("prior_inlier_ratio", &prior_inlier_ratio, "a prior pose explaining this share skips RANSAC");
+  }
+};
+
+struct PoseEstimate {
+  bool ok = false;
+  Rigid3d cam_from_world;
+  Matrix6d covariance = Matrix6d::Zero();  // left perturbation [t; r] of cam_from_world
+  std::vector<uint8_t> inliers;
+  int num_inliers = 0;
+  double rms_px = 0.0;                     // RMS reprojection error of the inliers (px)
+  bool used_ransac = false;
+};
+
+// `prior` (e.g. constant-velocity prediction) is refined directly when it already
+// explains most correspondences; otherwise EPnP RANSAC runs first.
+PoseEstimate EstimatePose(const std::vector<Eigen::Vector3d>& points_in_world,
+                          const std::vector<Eigen::Vector2d>& xy, double focal_px,
+                          const std::optional<Rigid3d>& prior, const PoseEstimatorOptions& options);
+
+// Motion-only refinement (Huber-weighted Gauss-Newton on a left perturbation).
+// Returns the refined pose and sets the information matrix J^T W J (in 1/px^2 units
+// scaled by focal^2) when `information` is given.
+Rigid3d RefinePose(const Rigid3d& initial, const std::vector<Eigen::Vector3d>& points_in_world,
+                   const std::vector<Eigen::Vector2d>& xy, const std::vector<uint8_t>& use,
+                   double focal_px, double huber_px, int iterations, Matrix6d* information);
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_SLAM_POSE_ESTIMATOR_H_

@@ -1,0 +1,660 @@
+#include "services/perception/slam/slam_system.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "common/util/logging.h"
+#include "services/perception/geometry/polygon.h"
+#include "services/perception/slam/triangulation.h"
+
+namespace mbslam {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+const char* SlamStateName(SlamState state) {
+  switch (state) {
+    case SlamState::kNotInitialized: return "not_initialized";
+    case SlamState::kInitializing: return "initializing";
+    case SlamState::kConfirming: return "confirming";
+    case SlamState::kTracking: return "tracking";
+    case SlamState::kLost: return "lost";
+  }
+  return "unknown";
+}
+
+SlamSystem::SlamSystem(const SlamOptions& options) : options_(options) {
+  if (!options_.map_load_path.empty()) {
+    const Status s = LoadMap(options_.map_load_path);
+    if (!s.ok()) MBSLAM_LOG(WARNING) << "map not loaded: " << s.message();
+  }
+}
+
+SlamSystem::~SlamSystem() {
+  Flush();
+  if (!options_.map_save_path.empty() && map_.num_keyframes() > 0) {
+    const Status s = SaveMap(options_.map_save_path);
+    if (!s.ok()) MBSLAM_LOG(ERROR) << "map not saved: " << s.message();
+  }
+}
+
+void SlamSystem::Flush() { MergeBundleAdjustment(/*wait=*/true); }
+
+void SlamSystem::Reset() {
+  Flush();
+  map_.Clear();
+  state_ = SlamState::kNotInitialized;
+  init_ref_frame_ = -1;
+  init_ref_xy_.clear();
+  init_ref_odom_.reset();
+  recent_poses_.clear();
+  lost_frames_ = 0;
+  metric_ = false;
+  confirm_count_ = 0;
+}
+
+Status SlamSystem::SaveMap(const std::string& path) {
+  Flush();
+  return map_.Save(path);
+}
+
+Status SlamSystem::LoadMap(const std::string& path) {
+  Flush();
+  MBSLAM_RETURN_IF_ERROR(map_.Load(path));
+  // A loaded map is only trusted after the camera relocalises against it; without
+  // descriptors that means re-initialising, so it serves as a prior for display.
+  MBSLAM_LOG(INFO) << "map loaded: " << map_.num_keyframes() << " keyframes, " << map_.num_points() << " points";
+  return Status::Ok();
+}
+
+std::optional<Rigid3d> SlamSystem::PredictPose(const SlamFrame& frame) const {
+  if (recent_poses_.empty()) return std::nullopt;
+  auto last = recent_poses_.rbegin();
+  const int64_t a = last->first;
+  const Rigid3d& Ta = last->second.cam_from_world;
+  // Odometry: the camera motion since frame a (metric map: directly; otherwise the
+  // rotation only, translation from constant velocity below).
+  std::optional<Rigid3d> odo_delta;
+  auto oa = recent_odometry_.find(a);
+  if (options_.use_odometry && frame.odom_from_cam && oa != recent_odometry_.end()) {
+    odo_delta = frame.odom_from_cam->Inverse() * oa->second;  // cam_n_from_cam_a
+  }
+  if (odo_delta && metric_) return *odo_delta * Ta;
+  if (recent_poses_.size() < 2) return odo_delta ? Rigid3d(odo_delta->rotation, Eigen::Vector3d::Zero()) * Ta : Ta;
+  auto prev = std::next(last);
+  const int64_t b = prev->first;
+  const Vector6d xi = (Ta * prev->second.cam_from_world.Inverse()).Log() / static_cast<double>(a - b);
+  return Rigid3d::Exp(xi * static_cast<double>(frame.frame_index - a)) * Ta;
+}
+
+SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
+  focal_px_ = frame.focal_px;
+  depth_grids_.clear();
+  MergeBundleAdjustment(/*wait=*/!options_.background_ba);
+  if (frame.odom_from_cam) recent_odometry_[frame.frame_index] = *frame.odom_from_cam;
+  while (recent_odometry_.size() > 64) recent_odometry_.erase(recent_odometry_.begin());
+  SlamPose out;
+  if (!options_.enabled) return out;
+  if (state_ == SlamState::kNotInitialized || state_ == SlamState::kInitializing) {
+    TryInitialize(frame, &out);
+    last_frame_ = frame.frame_index;
+    return out;
+  }
+  // Tracking: 2D-3D correspondences through the tracks that observe map points and
+  // were not labelled moving.
+  std::vector<Eigen::Vector3d> X;
+  std::vector<Eigen::Vector2d> xy;
+  std::vector<int64_t> tracks;
+  for (const SlamObservation& o : frame.observations) {
+    if (o.body_id > 0) continue;
+    const int64_t pid = map_.PointOfTrack(o.track_id);
+    if (pid < 0) continue;
+    const MapPoint* p = map_.point(pid);
+    X.push_back(p->position);
+    xy.push_back(o.xy);
+    tracks.push_back(o.track_id);
+  }
+  out.num_correspondences = static_cast<int>(X.size());
+  const std::optional<Rigid3d> prior = PredictPose(frame);
+  PoseEstimate est;
+  if (X.size() >= 6) est = EstimatePose(X, xy, frame.focal_px, prior, options_.pose);
+  const bool good = est.ok && est.num_inliers >= options_.min_tracking_inliers;
+  if (good && state_ == SlamState::kConfirming) {
+    const double ratio = static_cast<double>(est.num_inliers) / static_cast<double>(X.size());
+    if (ratio < options_.init_confirm_inlier_ratio) {
+      MBSLAM_LOG(INFO) << "SLAM: new map not confirmed (inlier share " << ratio << "); retrying";
+      Reset();
+      out.state = state_;
+      return out;
+    }
+    if (++confirm_count_ >= options_.init_confirm_frames) {
+      state_ = SlamState::kTracking;
+      out.relocalized = just_initialized_;
+      MBSLAM_LOG(INFO) << "SLAM: map confirmed (" << map_.num_points() << " points)";
+    }
+  }
+  if (good) {
+    if (state_ == SlamState::kLost) state_ = SlamState::kTracking;
+    lost_frames_ = 0;
+    out.valid = state_ == SlamState::kTracking;
+    out.cam_from_world = est.cam_from_world;
+    out.covariance = est.covariance;
+    out.num_inliers = est.num_inliers;
+    last_inliers_ = est.num_inliers;
+    recent_poses_[frame.frame_index] = FramePose{est.cam_from_world, est.covariance};
+    for (size_t i = 0; i < tracks.size(); ++i) {
+      const int64_t pid = map_.PointOfTrack(tracks[i]);
+      MapPoint* p = map_.point(pid);
+      if (!p) continue;
+      ++p->times_visible;
+      if (est.inliers[i]) {
+        ++p->times_found;
+        p->last_seen_frame = frame.frame_index;
+        p->occluded = false;
+      } else {
+        map_.ReleaseTrack(tracks[i]);  // the track drifted off its point
+      }
+    }
+  } else {
+    ++lost_frames_;
+    if (state_ == SlamState::kConfirming) {
+      Reset();
+    } else {
+      state_ = SlamState::kLost;
+      if (lost_frames_ >= options_.lost_frames_to_reinit) {
+        MBSLAM_LOG(WARNING) << "SLAM: lost for " << lost_frames_ << " frames; re-initialising";
+        Reset();
+        just_initialized_ = true;
+      }
+    }
+  }
+  while (recent_poses_.size() > 64) recent_poses_.erase(recent_poses_.begin());
+  out.state = state_;
+  out.metric = metric_;
+  out.scale_to_metric = metric_ ? 1.0 : 0.0;
+  last_frame_ = frame.frame_index;
+  return out;
+}
+
+void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
+  out->state = state_;
+  std::unordered_map<int64_t, Eigen::Vector2d> current;
+  for (const SlamObservation& o : frame.observations) {
+    if (o.body_id <= 0) current[o.track_id] = o.xy;
+  }
+  auto set_reference = [&]() {
+    if (static_cast<int>(current.size()) < options_.init_min_tracks) {
+      init_ref_frame_ = -1;
+      state_ = SlamState::kNotInitialized;
+      return;
+    }
+    init_ref_frame_ = frame.frame_index;
+    init_ref_xy_ = current;
+    init_ref_odom_ = frame.odom_from_cam;
+    state_ = SlamState::kInitializing;
+  };
+  if (init_ref_frame_ < 0 || frame.frame_index - init_ref_frame_ > options_.init_max_frames) {
+    set_reference();
+    out->state = state_;
+    return;
+  }
+  std::vector<int64_t> ids;
+  std::vector<Eigen::Vector2d> xr, xn;
+  std::vector<double> disp;
+  for (const auto& [id, x] : current) {
+    auto it = init_ref_xy_.find(id);
+    if (it == init_ref_xy_.end()) continue;
+    ids.push_back(id);
+    xr.push_back(it->second);
+    xn.push_back(x);
+    disp.push_back((x - it->second).norm() * frame.focal_px);
+  }
+  if (static_cast<int>(ids.size()) < options_.init_min_tracks) {
+    set_reference();  // the reference has too few tracks left
+    out->state = state_;
+    return;
+  }
+  if (Median(disp) < 8.0) return;  // not enough motion yet
+
+  const size_t n = ids.size();
+  std::vector<cv::Point2d> pr(n), pn(n);
+  for (size_t i = 0; i < n; ++i) {
+    pr[i] = cv::Point2d(xr[i].x(), xr[i].y());
+    pn[i] = cv::Point2d(xn[i].x(), xn[i].y());
+  }
+  const double thresh = 1.0 / frame.focal_px;
+  cv::Mat e_mask, h_mask;
+  cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, e_mask);
+  cv::Mat H = cv::findHomography(pr, pn, cv::RANSAC, 1.5 * thresh, h_mask, 2000, 0.999);
+  if (E.empty() || E.rows != 3) return;
+  const int e_inl = cv::countNonZero(e_mask);
+  const int h_inl = H.empty() ? 0 : cv::countNonZero(h_mask);
+
+  // Candidate motions: from E (recoverPose), or from the homography decomposition
+  // when the homography explains the views (planar scene or too little parallax).
+  struct Candidate {
+    Rigid3d cam1_from_cam0;
+    cv::Mat mask;
+  };
+  std::vector<Candidate> candidates;
+  const bool planar = h_inl >= options_.init_homography_ratio * e_inl;
+  if (!planar) {
+    cv::Mat R, t, mask = e_mask.clone();
+    if (cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask) <
+        options_.init_min_points) {
+      return;
+    }
+    Eigen::Matrix3d Re;
+    Eigen::Vector3d te;
+    cv::cv2eigen(R, Re);
+    cv::cv2eigen(t, te);
+    candidates.push_back(Candidate{Rigid3d(Re, te.normalized()), mask});
+  } else {
+    std::vector<cv::Mat> Rs, ts, normals;
+    cv::decomposeHomographyMat(H, cv::Mat::eye(3, 3, CV_64F), Rs, ts, normals);
+    for (size_t i = 0; i < Rs.size(); ++i) {
+      Eigen::Matrix3d Re;
+      Eigen::Vector3d te;
+      cv::cv2eigen(Rs[i], Re);
+      cv::cv2eigen(ts[i], te);
+      if (te.norm() < 1e-9) continue;
+      candidates.push_back(Candidate{Rigid3d(Re, te.normalized()), h_mask});
+    }
+  }
+  // Triangulate each candidate; keep the one with most good points.
+  struct Result {
+    Rigid3d T;
+    std::vector<std::pair<size_t, Eigen::Vector3d>> points;
+    double median_parallax = 0.0;
+  };
+  std::optional<Result> best;
+  const double max_err = options_.triangulation_max_error_px / frame.focal_px;
+  for (const Candidate& c : candidates) {
+    Result r;
+    r.T = c.cam1_from_cam0;
+    std::vector<double> parallax;
+    for (size_t i = 0; i < n; ++i) {
+      if (!c.mask.at<uint8_t>(static_cast<int>(i))) continue;
+      const std::optional<Eigen::Vector3d> X = TriangulateDlt(Rigid3d(), xr[i], r.T, xn[i]);
+      if (!X) continue;
+      if (ReprojectionError(Rigid3d(), *X, xr[i]) > max_err || ReprojectionError(r.T, *X, xn[i]) > max_err) {
+        continue;
+      }
+      const double angle = ParallaxAngle(Rigid3d(), r.T, *X);
+      parallax.push_back(angle);
+      if (angle < options_.triangulation_min_angle_deg * kDeg) continue;
+      r.points.emplace_back(i, *X);
+    }
+    r.median_parallax = Median(parallax);
+    if (!best || r.points.size() > best->points.size()) best = r;
+  }
+  if (!best || static_cast<int>(best->points.size()) < options_.init_min_points ||
+      best->median_parallax < options_.init_min_parallax_deg * kDeg) {
+    MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": E inliers " << e_inl
+                      << ", H inliers " << h_inl << (planar ? " (planar)" : "") << ", points "
+                      << (best ? best->points.size() : 0) << ", median parallax "
+                      << (best ? best->median_parallax / kDeg : 0.0) << " deg";
+    return;  // refuse for now; more parallax will come (or the reference is replaced)
+  }
+
+  // Build the map: keyframe 0 at the reference (fixed gauge), keyframe 1 here.
+  map_.Clear();
+  recent_poses_.clear();
+  // Scale: metric from the odometry baseline when available, else median depth 1.
+  double scale = 1.0;
+  metric_ = false;
+  if (options_.use_odometry && init_ref_odom_ && frame.odom_from_cam) {
+    const double baseline = (frame.odom_from_cam->Inverse() * *init_ref_odom_).translation.norm();
+    if (baseline > 1e-3) {
+      scale = baseline;  // translation of the two-view motion has unit norm
+      metric_ = true;
+    }
+  }
+  if (!metric_) {
+    std::vector<double> depths;
+    for (const auto& [i, X] : best->points) depths.push_back(X.z());
+    scale = 1.0 / std::max(1e-9, Median(depths));
+  }
+  Keyframe k0;
+  k0.frame_index = init_ref_frame_;
+  k0.cam_from_world = Rigid3d();
+  k0.fixed = true;
+  k0.track_xy = init_ref_xy_;
+  if (init_ref_odom_) {
+    k0.has_odometry = true;
+    k0.odom_from_cam = *init_ref_odom_;
+  }
+  Keyframe k1;
+  k1.frame_index = frame.frame_index;
+  k1.utime = frame.utime;
+  k1.cam_from_world = Rigid3d(best->T.rotation, best->T.translation * scale);
+  k1.track_xy = current;
+  for (const SlamObservation& o : frame.observations) {
+    if (o.body_id <= 0) k1.track_uv[o.track_id] = o.uv;
+  }
+  if (frame.odom_from_cam) {
+    k1.has_odometry = true;
+    k1.odom_from_cam = *frame.odom_from_cam;
+  }
+  const int64_t id0 = map_.AddKeyframe(std::move(k0));
+  const int64_t id1 = map_.AddKeyframe(std::move(k1));
+  for (const auto& [i, X] : best->points) {
+    MapPoint p;
+    p.position = X * scale;
+    p.track_id = ids[i];
+    p.created_frame = frame.frame_index;
+    p.last_seen_frame = frame.frame_index;
+    p.gray = frame.mean_gray;
+    const int64_t pid = map_.AddPoint(std::move(p));
+    map_.AddObservation(pid, id0, xr[i]);
+    map_.AddObservation(pid, id1, xn[i]);
+  }
+  // Global BA of the two views, inline.
+  BaProblem problem = ExtractBaProblem(map_, 2, true, frame.focal_px, metric_);
+  const BaSummary s = SolveBa(&problem, options_.ba);
+  if (s.usable) ApplyBaResult(problem, options_.ba, &map_);
+  ++ba_runs_;
+  const Keyframe& kf1 = *map_.keyframe(id1);
+  recent_poses_[init_ref_frame_] = FramePose{Rigid3d(), Matrix6d::Identity() * 1e-6};
+  recent_poses_[frame.frame_index] = FramePose{kf1.cam_from_world, Matrix6d::Identity() * 1e-4};
+  last_keyframe_frame_ = frame.frame_index;
+  tracked_points_at_keyframe_ = static_cast<int>(map_.num_points());
+  state_ = options_.init_confirm_frames > 0 ? SlamState::kConfirming : SlamState::kTracking;
+  confirm_count_ = 0;
+  MBSLAM_LOG(INFO) << "SLAM: initialised from frames " << init_ref_frame_ << "-" << frame.frame_index << " with "
+                   << map_.num_points() << " points (" << (planar ? "homography" : "essential")
+                   << ", median parallax " << best->median_parallax / kDeg << " deg"
+                   << (metric_ ? ", metric scale from odometry" : "") << ")";
+  out->state = state_;
+  out->valid = state_ == SlamState::kTracking;
+  out->cam_from_world = kf1.cam_from_world;
+  out->covariance = Matrix6d::Identity() * 1e-4;
+  out->num_inliers = static_cast<int>(map_.num_points());
+  out->metric = metric_;
+  out->scale_to_metric = metric_ ? 1.0 : 0.0;
+}
+
+bool SlamSystem::NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const {
+  const int64_t since = frame.frame_index - last_keyframe_frame_;
+  if (since < options_.keyframe_min_frames) return false;
+  if (since >= options_.keyframe_max_frames) return true;
+  if (last_inliers_ < options_.keyframe_tracked_ratio * tracked_points_at_keyframe_) return true;
+  // Parallax to the last keyframe (rotation compensated, via the poses).
+  const Keyframe* kf = map_.LastKeyframe();
+  auto cur = recent_poses_.find(frame.frame_index);
+  if (!kf || cur == recent_poses_.end()) return false;
+  const Eigen::Matrix3d Rk = kf->cam_from_world.RotationMatrix().transpose();
+  const Eigen::Matrix3d Rc = cur->second.cam_from_world.RotationMatrix().transpose();
+  std::vector<double> angles;
+  for (const SlamObservation& o : frame.observations) {
+    auto it = kf->track_xy.find(o.track_id);
+    if (it == kf->track_xy.end()) continue;
+    const Eigen::Vector3d a = (Rk * it->second.homogeneous()).normalized();
+    const Eigen::Vector3d b = (Rc * o.xy.homogeneous()).normalized();
+    angles.push_back(std::acos(std::clamp(a.dot(b), -1.0, 1.0)));
+  }
+  return Median(angles) > options_.keyframe_parallax_deg * kDeg;
+}
+
+void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels,
+                             SlamMapUpdate* update) {
+  const Rigid3d T = recent_poses_.at(frame.frame_index).cam_from_world;
+  Keyframe kf;
+  kf.frame_index = frame.frame_index;
+  kf.utime = frame.utime;
+  kf.cam_from_world = T;
+  if (frame.odom_from_cam) {
+    kf.has_odometry = true;
+    kf.odom_from_cam = *frame.odom_from_cam;
+  }
+  auto is_static = [&labels](int64_t track) {
+    auto it = labels.find(track);
+    return it != labels.end() && it->second == 0;
+  };
+  for (const SlamObservation& o : frame.observations) {
+    if (!is_static(o.track_id)) continue;
+    kf.track_xy[o.track_id] = o.xy;
+    kf.track_uv[o.track_id] = o.uv;
+  }
+  const int64_t kid = map_.AddKeyframe(std::move(kf));
+  const Keyframe& k = *map_.keyframe(kid);
+  const double max_err = options_.triangulation_max_error_px / frame.focal_px;
+  int tracked = 0;
+  for (const auto& [track, x] : k.track_xy) {
+    const int64_t pid = map_.PointOfTrack(track);
+    if (pid >= 0) {
+      const MapPoint* p = map_.point(pid);
+      if (ReprojectionError(T, p->position, x) <= 2.0 * max_err) {
+        map_.AddObservation(pid, kid, x);
+        ++tracked;
+      }
+      continue;
+    }
+    // Triangulate against the oldest keyframe (of the last few) that saw this track.
+    const Keyframe* first = nullptr;
+    int looked = 0;
+    for (auto it = map_.keyframes().rbegin(); it != map_.keyframes().rend() && looked < 10; ++it, ++looked) {
+      if (it->first == kid) continue;
+      if (it->second.track_xy.count(track)) first = &it->second;
+    }
+    if (!first) continue;
+    const Eigen::Vector2d& x0 = first->track_xy.at(track);
+    const std::optional<Eigen::Vector3d> X = TriangulateDlt(first->cam_from_world, x0, T, x);
+    if (!X) continue;
+    if (ParallaxAngle(first->cam_from_world, T, *X) < options_.triangulation_min_angle_deg * kDeg) continue;
+    if (ReprojectionError(first->cam_from_world, *X, x0) > max_err || ReprojectionError(T, *X, x) > max_err) {
+      continue;
+    }
+    MapPoint p;
+    p.position = *X;
+    p.track_id = track;
+    p.created_frame = frame.frame_index;
+    p.last_seen_frame = frame.frame_index;
+    p.gray = frame.mean_gray;
+    const int64_t new_pid = map_.AddPoint(std::move(p));
+    // Every keyframe between that saw the track and agrees gets the observation.
+    for (auto& [id, other] : map_.keyframes()) {
+      auto it = other.track_xy.find(track);
+      if (it == other.track_xy.end()) continue;
+      if (ReprojectionError(other.cam_from_world, *X, it->second) <= 2.0 * max_err) {
+        map_.AddObservation(new_pid, id, it->second);
+      }
+    }
+    update->new_point_ids.push_back(new_pid);
+  }
+  tracked_points_at_keyframe_ = tracked + static_cast<int>(update->new_point_ids.size());
+  last_keyframe_frame_ = frame.frame_index;
+  update->new_keyframe = true;
+  CullKeyframes();
+}
+
+void SlamSystem::CullKeyframes() {
+  while (static_cast<int>(map_.num_keyframes()) > options_.max_keyframes) {
+    auto oldest = map_.keyframes().begin();
+    const int64_t id = oldest->first;
+    const bool was_fixed = oldest->second.fixed;
+    const std::vector<int64_t> pids = oldest->second.point_ids;
+    for (int64_t pid : pids) {
+      MapPoint* p = map_.point(pid);
+      if (!p) continue;
+      p->observations.erase(std::remove_if(p->observations.begin(), p->observations.end(),
+                                           [id](const Observation& o) { return o.keyframe_id == id; }),
+                            p->observations.end());
+      if (p->observations.size() < 2 && p->track_id < 0) map_.RemovePoint(pid);
+    }
+    map_.keyframes().erase(id);
+    if (was_fixed && !map_.keyframes().empty()) map_.keyframes().begin()->second.fixed = true;
+  }
+}
+
+SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) {
+  SlamMapUpdate update;
+  if (map_.num_keyframes() == 0) return update;
+  // Segmentation feedback (sec. 4.3): a track that joined a moving object takes its
+  // point out of the static map (the object starts from it); one that is merely
+  // unexplained releases its point.
+  for (const SlamObservation& o : frame.observations) {
+    const int64_t pid = map_.PointOfTrack(o.track_id);
+    if (pid < 0) continue;
+    auto it = labels.find(o.track_id);
+    if (it == labels.end() || it->second == 0) continue;
+    if (it->second > 0) {
+      update.released_points.push_back(map_.point(pid)->position);
+      update.released_tracks.push_back(o.track_id);
+      map_.RemovePoint(pid);
+    } else {
+      map_.ReleaseTrack(o.track_id);
+    }
+  }
+  auto cur = recent_poses_.find(frame.frame_index);
+  if (cur != recent_poses_.end() && !frame.moving_hulls_xy.empty()) {
+    // Points of the recent keyframes behind a moving hull are occluded, not lost.
+    std::set<int64_t> recent;
+    int n = 0;
+    for (auto it = map_.keyframes().rbegin(); it != map_.keyframes().rend() && n < 3; ++it, ++n) {
+      recent.insert(it->second.point_ids.begin(), it->second.point_ids.end());
+    }
+    for (int64_t pid : recent) {
+      MapPoint* p = map_.point(pid);
+      if (!p || p->track_id >= 0) continue;
+      const Eigen::Vector3d pc = cur->second.cam_from_world * p->position;
+      if (pc.z() <= 0) continue;
+      const Eigen::Vector2f xy = pc.hnormalized().cast<float>();
+      bool inside = false;
+      for (const auto& hull : frame.moving_hulls_xy) inside = inside || InsideConvexHull(hull, xy);
+      p->occluded = inside;
+    }
+  }
+  if (state_ != SlamState::kTracking && state_ != SlamState::kConfirming) return update;
+  if (cur == recent_poses_.end()) return update;
+  if (NeedKeyframe(frame, labels)) {
+    AddKeyframe(frame, labels, &update);
+    StartBundleAdjustment(static_cast<int>(map_.num_keyframes()) <= options_.ba.global_max_keyframes);
+  }
+  return update;
+}
+
+void SlamSystem::StartBundleAdjustment(bool global) {
+  if (!options_.background_ba) {
+    BaProblem problem = ExtractBaProblem(map_, options_.ba.window_keyframes, global, focal_px_,
+                                         metric_ && options_.use_odometry);
+    const BaSummary s = SolveBa(&problem, options_.ba);
+    ++ba_runs_;
+    last_ba_seconds_ = s.seconds;
+    if (s.usable) ApplyBaResult(problem, options_.ba, &map_);
+    return;
+  }
+  if (ba_running_) return;  // the next keyframe triggers another run
+  MergeBundleAdjustment(true);
+  ba_problem_ = std::make_unique<BaProblem>(ExtractBaProblem(
+      map_, options_.ba.window_keyframes, global, focal_px_, metric_ && options_.use_odometry));
+  ba_running_ = true;
+  ba_thread_ = std::thread([this] {
+    ba_summary_ = SolveBa(ba_problem_.get(), options_.ba);
+    ba_running_ = false;
+  });
+}
+
+void SlamSystem::MergeBundleAdjustment(bool wait) {
+  if (!ba_thread_.joinable()) return;
+  if (!wait && ba_running_) return;
+  ba_thread_.join();
+  ++ba_runs_;
+  last_ba_seconds_ = ba_summary_.seconds;
+  if (ba_summary_.usable && ba_problem_) ApplyBaResult(*ba_problem_, options_.ba, &map_);
+  ba_problem_.reset();
+}
+
+std::optional<RelativeMotion> SlamSystem::RelativeMotionBetween(int64_t ref, int64_t cur) const {
+  auto r = recent_poses_.find(ref);
+  auto n = recent_poses_.find(cur);
+  if (r == recent_poses_.end() || n == recent_poses_.end() || !initialized()) return std::nullopt;
+  RelativeMotion m;
+  m.cam_n_from_cam_r = n->second.cam_from_world * r->second.cam_from_world.Inverse();
+  const Matrix6d ad = m.cam_n_from_cam_r.Adjoint();
+  m.covariance = n->second.covariance + ad * r->second.covariance * ad.transpose();
+  m.translation_known = m.cam_n_from_cam_r.translation.norm() > 1e-9;
+  m.scale_known = true;
+  m.source = RelativeMotion::Source::kSlam;
+  return m;
+}
+
+const SlamSystem::DepthGrid& SlamSystem::GridFor(int64_t frame, const Rigid3d& T) const {
+  auto it = depth_grids_.find(frame);
+  if (it != depth_grids_.end()) return it->second;
+  DepthGrid grid;
+  constexpr double kCell = 0.08;
+  std::set<int64_t> seen;
+  int kfs = 0;
+  for (auto k = map_.keyframes().rbegin(); k != map_.keyframes().rend() && kfs < 3; ++k, ++kfs) {
+    for (int64_t id : k->second.point_ids) {
+      if (!seen.insert(id).second) continue;
+      const MapPoint* p = map_.point(id);
+      if (!p) continue;
+      const Eigen::Vector3d pc = T * p->position;
+      if (pc.z() <= 0.0) continue;
+      const Eigen::Vector2d xy = pc.hnormalized();
+      const int64_t key = (static_cast<int64_t>(std::floor(xy.x() / kCell)) << 32) ^
+                          (static_cast<int64_t>(std::floor(xy.y() / kCell)) & 0xffffffff);
+      auto [cell, inserted] = grid.cells.try_emplace(key, pc.z(), pc.z());
+      if (!inserted) {
+        cell->second.first = std::min(cell->second.first, pc.z());
+        cell->second.second = std::max(cell->second.second, pc.z());
+      }
+      ++grid.counts[key];
+    }
+  }
+  return depth_grids_.emplace(frame, std::move(grid)).first->second;
+}
+
+DepthBound SlamSystem::DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const {
+  DepthBound bound;
+  auto r = recent_poses_.find(frame);
+  if (r == recent_poses_.end() || !initialized()) return bound;
+  const Rigid3d& T = r->second.cam_from_world;
+  const int64_t pid = map_.PointOfTrack(track_id);
+  if (pid >= 0) {
+    const double z = (T * map_.point(pid)->position).z();
+    if (z > 0.0) {
+      return DepthBound{z * (1.0 - options_.depth_bound_margin), z * (1.0 + options_.depth_bound_margin)};
+    }
+  }
+  // The frustum around the ray: depths of the map points of the last keyframes that
+  // project within one grid cell (~0.08 normalised units, ~40 px) of it.
+  const DepthGrid& grid = GridFor(frame, T);
+  constexpr double kCell = 0.08;
+  const int64_t cx = static_cast<int64_t>(std::floor(xy.x() / kCell));
+  const int64_t cy = static_cast<int64_t>(std::floor(xy.y() / kCell));
+  double zmin = std::numeric_limits<double>::max(), zmax = 0.0;
+  int n = 0;
+  for (int64_t dx = -1; dx <= 1; ++dx) {
+    for (int64_t dy = -1; dy <= 1; ++dy) {
+      const int64_t key = ((cx + dx) << 32) ^ ((cy + dy) & 0xffffffff);
+      auto it = grid.cells.find(key);
+      if (it == grid.cells.end()) continue;
+      zmin = std::min(zmin, it->second.first);
+      zmax = std::max(zmax, it->second.second);
+      n += grid.counts.at(key);
+    }
+  }
+  if (n >= 3) {
+    bound.z_min = zmin / options_.frustum_bound_factor;
+    bound.z_max = zmax * options_.frustum_bound_factor;
+  }
+  return bound;
+}
+
+}  // namespace mbslam

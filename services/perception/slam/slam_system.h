@@ -1,0 +1,251 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_SLAM_SLAM_SYSTEM_H_
+#define MBSLAM_SERVICES_PERCEPTION_SLAM_SLAM_SYSTEM_H_
+
+// Monocular keyframe SLAM of one body (thesis ch. 4), fed only with the tracks that
+// segmentation assigns to that body. Per image, in the order of the coupled loop:
+//   TrackPose()   pose of the camera w.r.t. the body (EPnP RANSAC + motion-only
+//                 refinement, constant-velocity or odometry prior), before segmentation,
+//                 so that segmentation gets the relative motion and depth bounds;
+//   UpdateMap()   after segmentation: moving tracks leave the map, keyframes,
+//                 triangulation, culling, local bundle adjustment (inline, or in a
+//                 back-end thread whose result is merged at the next image).
+// Initialisation: two views with enough parallax, essential matrix (5-point RANSAC)
+// against a homography (model selection), refusal on too little parallax, and a
+// confirmation by the following views (the 3-view check of sec. 4.4) before the map is
+// trusted; failures retry automatically. With odometry the map is metric.
+
+#include <atomic>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/config/options.h"
+#include "common/util/status.h"
+#include "services/perception/geometry/rigid3.h"
+#include "services/perception/segmentation/relative_motion.h"
+#include "services/perception/segmentation/static_likelihood.h"
+#include "services/perception/slam/bundle_adjuster.h"
+#include "services/perception/slam/map.h"
+#include "services/perception/slam/pose_estimator.h"
+
+namespace mbslam {
+
+struct SlamOptions {
+  PoseEstimatorOptions pose;
+  BundleAdjustmentOptions ba;
+  bool enabled = true;                   // run SLAM on the static world
+  int init_min_tracks = 80;              // static tracks needed to start an initialisation (count)
+  double init_min_parallax_deg = 1.0;    // median parallax angle of the two views (deg)
+  int init_min_points = 50;              // triangulated points needed (count)
+  int init_max_frames = 90;              // the reference view is replaced after this (frames)
+  double init_homography_ratio = 0.95;   // H inliers / E inliers above this = planar / low parallax: use H or refuse
+  int init_confirm_frames = 3;           // frames the new map must track well before it is trusted (frames)
+  double init_confirm_inlier_ratio = 0.7;  // inlier share required while confirming
+  double triangulation_min_angle_deg = 1.0;  // new points need this parallax (deg)
+  double triangulation_max_error_px = 2.0;   // ... and this reprojection error in both views (px)
+  int keyframe_min_frames = 3;           // frames between keyframes at least (frames)
+  int keyframe_max_frames = 20;          // a keyframe at least this often while tracking (frames)
+  double keyframe_tracked_ratio = 0.75;  // fewer tracked map points than this share of the last keyframe's: new keyframe
+  double keyframe_parallax_deg = 2.0;    // median parallax to the last keyframe above this: new keyframe (deg)
+  int min_tracking_inliers = 20;         // fewer inliers = tracking lost (count)
+  int lost_frames_to_reinit = 10;        // frames lost before the map is dropped and re-initialised (frames)
+  int max_keyframes = 200;               // oldest keyframes are culled beyond this (count)
+  bool background_ba = true;             // local BA in a back-end thread (realtime); false: inline (deterministic)
+  bool use_odometry = true;              // odometry gives the prior motion and the metric scale
+  double depth_bound_margin = 0.15;      // known-depth bound: depth * (1 +- margin)
+  double frustum_bound_factor = 2.0;     // frustum bound: [min / f, max * f] of map depths around the ray
+  std::string map_load_path;             // map loaded at start ("" = none)
+  std::string map_save_path;             // map saved at exit ("" = none)
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION_SECTION(pose);
+    MBSLAM_CHECK_OPTION_SECTION(ba);
+    MBSLAM_CHECK_OPTION_GE(init_min_tracks, 8);
+    MBSLAM_CHECK_OPTION_GT(init_min_parallax_deg, 0.0);
+    MBSLAM_CHECK_OPTION_GE(init_min_points, 8);
+    MBSLAM_CHECK_OPTION_GT(init_max_frames, 1);
+    MBSLAM_CHECK_OPTION(init_homography_ratio > 0.0 && init_homography_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(init_confirm_frames, 0);
+    MBSLAM_CHECK_OPTION(init_confirm_inlier_ratio > 0.0 && init_confirm_inlier_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION_GT(triangulation_min_angle_deg, 0.0);
+    MBSLAM_CHECK_OPTION_GT(triangulation_max_error_px, 0.0);
+    MBSLAM_CHECK_OPTION_GE(keyframe_min_frames, 1);
+    MBSLAM_CHECK_OPTION_GE(keyframe_max_frames, keyframe_min_frames);
+    MBSLAM_CHECK_OPTION(keyframe_tracked_ratio > 0.0 && keyframe_tracked_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION_GT(keyframe_parallax_deg, 0.0);
+    MBSLAM_CHECK_OPTION_GE(min_tracking_inliers, 6);
+    MBSLAM_CHECK_OPTION_GE(lost_frames_to_reinit, 1);
+    MBSLAM_CHECK_OPTION_GE(max_keyframes, 3);
+    MBSLAM_CHECK_OPTION(depth_bound_margin > 0.0 && depth_bound_margin < 1.0);
+    MBSLAM_CHECK_OPTION_GT(frustum_bound_factor, 1.0);
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("pose", &pose, "camera resection");
+    v("ba", &ba, "bundle adjustment");
+    v("enabled", &enabled, "run SLAM on the static world");
+    v("init_min_tracks", &init_min_tracks, "static tracks to start an initialisation (count)");
+    v("init_min_parallax_deg", &init_min_parallax_deg, "median parallax of the two views (deg)");
+    v("init_min_points", &init_min_points, "triangulated points needed (count)");
+    v("init_max_frames", &init_max_frames, "reference view replaced after (frames)");
+    v("init_homography_ratio", &init_homography_ratio, "H/E inlier ratio meaning planar or low parallax");
+    v("init_confirm_frames", &init_confirm_frames, "frames a new map must track well (frames)");
+    v("init_confirm_inlier_ratio", &init_confirm_inlier_ratio, "inlier share while confirming");
+    v("triangulation_min_angle_deg", &triangulation_min_angle_deg, "parallax of new points (deg)");
+    v("triangulation_max_error_px", &triangulation_max_error_px, "reprojection error of new points (px)");
+    v("keyframe_min_frames", &keyframe_min_frames, "frames between keyframes at least (frames)");
+    v("keyframe_max_frames", &keyframe_max_frames, "a keyframe at least this often (frames)");
+    v("keyframe_tracked_ratio", &keyframe_tracked_ratio, "tracked-point share that triggers a keyframe");
+    v("keyframe_parallax_deg", &keyframe_parallax_deg, "parallax to the last keyframe that triggers one (deg)");
+    v("min_tracking_inliers", &min_tracking_inliers, "fewer inliers = lost (count)");
+    v("lost_frames_to_reinit", &lost_frames_to_reinit, "frames lost before re-initialising (frames)");
+    v("max_keyframes", &max_keyframes, "keyframes kept (count)");
+    v("background_ba", &background_ba, "local BA in a back-end thread (false: inline, deterministic)");
+    v("use_odometry", &use_odometry, "odometry as motion prior and metric scale");
+    v("depth_bound_margin", &depth_bound_margin, "known-depth bound: depth * (1 +- margin)");
+    v("frustum_bound_factor", &frustum_bound_factor, "frustum depth bound: [min / f, max * f]");
+    v("map_load_path", &map_load_path, "map loaded at start (\"\" = none)");
+    v("map_save_path", &map_save_path, "map saved at exit (\"\" = none)");
+  }
+};
+
+struct SlamObservation {
+  int64_t track_id = 0;
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // normalised
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // px
+  int body_id = -1;        // label from the previous segmentation (0 static)
+  bool is_new = false;
+};
+
+struct SlamFrame {
+  int64_t frame_index = 0;
+  int64_t utime = 0;
+  double focal_px = 1.0;
+  std::vector<SlamObservation> observations;          // active tracks
+  std::optional<Rigid3d> odom_from_cam;                // interpolated odometry (metric), if any
+  std::vector<std::vector<Eigen::Vector2f>> moving_hulls_xy;  // moving objects' hulls (normalised coordinates)
+  uint8_t mean_gray = 128;
+};
+
+enum class SlamState { kNotInitialized, kInitializing, kConfirming, kTracking, kLost };
+
+struct SlamPose {
+  SlamState state = SlamState::kNotInitialized;
+  bool valid = false;                      // a pose for this image exists
+  bool relocalized = false;                // first pose after a re-initialisation
+  Rigid3d cam_from_world;
+  Matrix6d covariance = Matrix6d::Zero();  // left perturbation [t; r] of cam_from_world
+  int num_inliers = 0;
+  int num_correspondences = 0;
+  bool metric = false;                     // map in metres (odometry)
+  double scale_to_metric = 0.0;
+};
+
+struct SlamMapUpdate {
+  bool new_keyframe = false;
+  std::vector<int64_t> new_point_ids;      // triangulated at this keyframe (occupancy rays)
+  std::vector<Eigen::Vector3d> released_points;  // static points whose tracks started moving (object seeds)
+  std::vector<int64_t> released_tracks;
+};
+
+class SlamSystem {
+ public:
+  explicit SlamSystem(const SlamOptions& options);
+  ~SlamSystem();
+  SlamSystem(const SlamSystem&) = delete;
+  SlamSystem& operator=(const SlamSystem&) = delete;
+
+  // Step 1 of an image: the camera pose w.r.t. the map.
+  SlamPose TrackPose(const SlamFrame& frame);
+  // Step 2, after segmentation: labels of this image (track id -> body) update the map.
+  SlamMapUpdate UpdateMap(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels);
+
+  // For segmentation: the camera motion between two recent images and its covariance,
+  // in map units (scale_known), or nullopt if either pose is missing.
+  std::optional<RelativeMotion> RelativeMotionBetween(int64_t ref_frame, int64_t cur_frame) const;
+  // Depth bound of a track in a recent image: its map point's depth, else the depth
+  // range of the map around its ray (the frustum), else [0, inf).
+  DepthBound DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const;
+
+  // Waits for the back-end, e.g. before reading the map or at the end of a replay.
+  void Flush();
+  void Reset();
+
+  const Map& map() const { return map_; }
+  SlamState state() const { return state_; }
+  bool initialized() const { return state_ == SlamState::kTracking || state_ == SlamState::kConfirming; }
+  bool HasPoint(int64_t track_id) const { return map_.PointOfTrack(track_id) >= 0; }
+  bool metric() const { return metric_; }
+  int64_t ba_runs() const { return ba_runs_; }
+  double last_ba_seconds() const { return last_ba_seconds_; }
+
+  Status SaveMap(const std::string& path);
+  Status LoadMap(const std::string& path);
+
+ private:
+  void TryInitialize(const SlamFrame& frame, SlamPose* pose);
+  void AddKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels,
+                   SlamMapUpdate* update);
+  bool NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const;
+  void StartBundleAdjustment(bool global);
+  void MergeBundleAdjustment(bool wait);
+  void CullKeyframes();
+  std::optional<Rigid3d> PredictPose(const SlamFrame& frame) const;
+
+  const SlamOptions options_;
+  Map map_;
+  SlamState state_ = SlamState::kNotInitialized;
+  double focal_px_ = 1.0;
+
+  // Initialisation reference view.
+  int64_t init_ref_frame_ = -1;
+  std::unordered_map<int64_t, Eigen::Vector2d> init_ref_xy_;
+  std::optional<Rigid3d> init_ref_odom_;
+  int confirm_count_ = 0;
+
+  // Recent camera poses (frame index -> pose, covariance) for segmentation.
+  struct FramePose {
+    Rigid3d cam_from_world;
+    Matrix6d covariance;
+  };
+  std::map<int64_t, FramePose> recent_poses_;
+  std::map<int64_t, Rigid3d> recent_odometry_;  // frame -> odom_from_cam
+  int64_t last_frame_ = -1;
+  int lost_frames_ = 0;
+  int tracked_points_at_keyframe_ = 0;
+  int64_t last_keyframe_frame_ = -1;
+  int last_inliers_ = 0;
+  bool metric_ = false;
+  bool just_initialized_ = false;
+
+  // Frustum depth grids per reference frame, rebuilt every image (the map changes).
+  struct DepthGrid {
+    std::unordered_map<int64_t, std::pair<double, double>> cells;  // cell key -> (min z, max z, counted below)
+    std::unordered_map<int64_t, int> counts;
+  };
+  mutable std::map<int64_t, DepthGrid> depth_grids_;
+  const DepthGrid& GridFor(int64_t frame, const Rigid3d& cam_from_world) const;
+
+  // Back-end.
+  std::thread ba_thread_;
+  std::atomic<bool> ba_running_{false};
+  std::unique_ptr<BaProblem> ba_problem_;
+  BaSummary ba_summary_;
+  int64_t ba_runs_ = 0;
+  double last_ba_seconds_ = 0.0;
+};
+
+const char* SlamStateName(SlamState state);
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_SLAM_SLAM_SYSTEM_H_
