@@ -1,7 +1,6 @@
 #include "common/lcm/lcm_bus.h"
 
 #include <cstdlib>
-#include <regex>
 
 #include "common/lcm/channels.h"
 #include "common/util/logging.h"
@@ -36,10 +35,12 @@ bool LcmBus::UrlLeavesHost(const std::string& url) {
   }
   if (effective.empty()) return false;  // LCM's default udpm URL uses ttl=0
   if (effective.rfind("udpm://", 0) != 0) return false;
-  static const std::regex ttl_re("[?&]ttl=([0-9]+)");
-  std::smatch m;
-  if (!std::regex_search(effective, m, ttl_re)) return false;
-  return std::atoi(m[1].str().c_str()) > 0;
+  // Find "ttl=<digits>" right after '?' or '&'.
+  for (size_t pos = effective.find("ttl="); pos != std::string::npos; pos = effective.find("ttl=", pos + 1)) {
+    if (pos == 0 || (effective[pos - 1] != '?' && effective[pos - 1] != '&')) continue;
+    return std::atoi(effective.c_str() + pos + 4) > 0;
+  }
+  return false;
 }
 
 std::unique_ptr<LcmBus> LcmBus::Create(const std::string& url, Status* status) {

@@ -53,65 +53,75 @@ BaProblem ExtractBaProblem(const Map& map, int window, bool global, double focal
 BaSummary SolveBa(BaProblem* p, const BundleAdjustmentOptions& o) {
   BaSummary summary;
   if (p->observations.empty()) return summary;
-  struct Block {
-    double q[4];
-    double t[3];
-  };
-  std::map<int64_t, Block> cams;
-  for (const auto& [id, pose] : p->keyframes) {
-    Block b;
-    const Eigen::Quaterniond& q = pose.cam_from_world.rotation;
-    b.q[0] = q.x();
-    b.q[1] = q.y();
-    b.q[2] = q.z();
-    b.q[3] = q.w();
-    for (int i = 0; i < 3; ++i) b.t[i] = pose.cam_from_world.translation[i];
-    cams[id] = b;
+  // All parameters live in one array, points first, then cameras, in id order: Ceres
+  // keeps its ordering groups as sets of pointers, so their order (and the floating
+  // point summation order of the solve) must not depend on where the heap put them,
+  // or lockstep replays would differ run to run.
+  std::map<int64_t, size_t> point_index, cam_index;
+  for (const auto& [id, X] : p->points) point_index.emplace(id, point_index.size());
+  for (const auto& [id, pose] : p->keyframes) cam_index.emplace(id, cam_index.size());
+  const size_t cam_offset = 3 * point_index.size();
+  std::vector<double> params(cam_offset + 7 * cam_index.size());
+  auto point_ptr = [&](int64_t id) { return params.data() + 3 * point_index.at(id); };
+  auto q_ptr = [&](int64_t id) { return params.data() + cam_offset + 7 * cam_index.at(id); };
+  auto t_ptr = [&](int64_t id) { return q_ptr(id) + 4; };
+  for (const auto& [id, X] : p->points) {
+    double* x = point_ptr(id);
+    x[0] = X.x();
+    x[1] = X.y();
+    x[2] = X.z();
   }
-  std::map<int64_t, Eigen::Vector3d> pts = p->points;
+  for (const auto& [id, pose] : p->keyframes) {
+    const Eigen::Quaterniond& q = pose.cam_from_world.rotation;
+    double* qp = q_ptr(id);
+    qp[0] = q.x();
+    qp[1] = q.y();
+    qp[2] = q.z();
+    qp[3] = q.w();
+    double* tp = t_ptr(id);
+    for (int i = 0; i < 3; ++i) tp[i] = pose.cam_from_world.translation[i];
+  }
 
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   ceres::LossFunction* loss = new ceres::HuberLoss(o.huber_px);  // owned by the problem
-  auto* ordering = new ceres::ParameterBlockOrdering;
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (const BaProblem::Obs& obs : p->observations) {
-    Block& cam = cams.at(obs.keyframe_id);
-    Eigen::Vector3d& X = pts.at(obs.point_id);
-    problem.AddResidualBlock(CreateReprojectionError(obs.xy, p->focal_px), loss, cam.q, cam.t, X.data());
+    problem.AddResidualBlock(CreateReprojectionError(obs.xy, p->focal_px), loss, q_ptr(obs.keyframe_id),
+                             t_ptr(obs.keyframe_id), point_ptr(obs.point_id));
     ++summary.residuals;
   }
-  for (auto& [id, X] : pts) ordering->AddElementToGroup(X.data(), 0);
-  for (auto& [id, cam] : cams) {
-    problem.SetManifold(cam.q, new ceres::EigenQuaternionManifold);
-    ordering->AddElementToGroup(cam.q, 1);
-    ordering->AddElementToGroup(cam.t, 1);
-    if (p->keyframes.at(id).fixed) {
-      problem.SetParameterBlockConstant(cam.q);
-      problem.SetParameterBlockConstant(cam.t);
+  for (const auto& [id, X] : p->points) ordering->AddElementToGroup(point_ptr(id), 0);
+  for (const auto& [id, pose] : p->keyframes) {
+    problem.SetManifold(q_ptr(id), new ceres::EigenQuaternionManifold);
+    ordering->AddElementToGroup(q_ptr(id), 1);
+    ordering->AddElementToGroup(t_ptr(id), 1);
+    if (pose.fixed) {
+      problem.SetParameterBlockConstant(q_ptr(id));
+      problem.SetParameterBlockConstant(t_ptr(id));
     }
   }
   if (p->use_odometry) {
     // Consecutive keyframes with odometry: metric displacement priors (scale).
     const BaProblem::Pose* prev = nullptr;
-    Block* prev_block = nullptr;
-    for (auto& [id, pose] : p->keyframes) {
+    int64_t prev_id = -1;
+    for (const auto& [id, pose] : p->keyframes) {
       if (!pose.has_odometry) continue;
       if (prev != nullptr) {
         // Displacement of camera b relative to camera a, expressed in a's frame.
         const Eigen::Vector3d d = (prev->odom_from_cam.Inverse() * pose.odom_from_cam).translation;
         const double sigma = o.odometry_sigma_floor_m + o.odometry_sigma_per_m * d.norm();
-        Block& cur = cams.at(id);
-        problem.AddResidualBlock(CreateOdometryTranslationPrior(d, sigma), nullptr, prev_block->q,
-                                 prev_block->t, cur.q, cur.t);
+        problem.AddResidualBlock(CreateOdometryTranslationPrior(d, sigma), nullptr, q_ptr(prev_id),
+                                 t_ptr(prev_id), q_ptr(id), t_ptr(id));
       }
       prev = &pose;
-      prev_block = &cams.at(id);
+      prev_id = id;
     }
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_SCHUR;
-  options.linear_solver_ordering.reset(ordering);
+  options.linear_solver_ordering = ordering;
   options.max_num_iterations = o.max_iterations;
   options.max_solver_time_in_seconds = o.max_seconds;
   options.num_threads = 1;
@@ -126,11 +136,14 @@ BaSummary SolveBa(BaProblem* p, const BundleAdjustmentOptions& o) {
   summary.seconds = s.total_time_in_seconds;
   if (!summary.usable) return summary;
   for (auto& [id, pose] : p->keyframes) {
-    const Block& b = cams.at(id);
-    pose.cam_from_world = Rigid3d(Eigen::Quaterniond(b.q[3], b.q[0], b.q[1], b.q[2]),
-                                  Eigen::Vector3d(b.t[0], b.t[1], b.t[2]));
+    const double* q = q_ptr(id);
+    const double* t = t_ptr(id);
+    pose.cam_from_world = Rigid3d(Eigen::Quaterniond(q[3], q[0], q[1], q[2]), Eigen::Vector3d(t[0], t[1], t[2]));
   }
-  p->points = pts;
+  for (auto& [id, X] : p->points) {
+    const double* x = point_ptr(id);
+    X = Eigen::Vector3d(x[0], x[1], x[2]);
+  }
   return summary;
 }
 
