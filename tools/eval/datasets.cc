@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "common/util/atomic_file.h"
+#include "tools/eval/point_metrics.h"
 
 namespace mbslam {
 namespace eval {
@@ -331,6 +332,16 @@ Status ReadSequenceFolder(const std::string& dir, SequenceFolder* seq) {
       MBSLAM_RETURN_IF_ERROR(
           ReadTumTrajectory((root / "objects" / (std::to_string(body.id) + ".tum")).string(), &body.poses));
       seq->bodies[body.id] = std::move(body);
+    }
+  }
+  const std::string points_dir = (root / "points").string();
+  if (IsDir(points_dir)) {
+    for (const auto& path : ListFiles(points_dir, ".txt")) {
+      const std::string stem = Stem(path);
+      char* end = nullptr;
+      const long id = std::strtol(stem.c_str(), &end, 10);
+      if (*end) continue;  // not a body id
+      MBSLAM_RETURN_IF_ERROR(ReadPointsFile(path, &seq->points[static_cast<int>(id)]));
     }
   }
   return Status::Ok();

@@ -114,6 +114,7 @@ struct SequenceFolder {
   std::vector<std::string> images;   // images/NNNNNN.png
   std::vector<std::string> masks;    // masks/NNNNNN.png (may be empty)
   std::vector<std::string> depths;   // depth/NNNNNN.exr|png (may be empty)
+  std::map<int, std::vector<Eigen::Vector3d>> points;  // points/<id>.txt: surface samples, body frame
 };
 Status ReadSequenceFolder(const std::string& dir, SequenceFolder* sequence);
 

@@ -34,6 +34,7 @@
 #include "tools/eval/object_metrics.h"
 #include "tools/eval/perturb.h"
 #include "tools/eval/plot.h"
+#include "tools/eval/point_metrics.h"
 #include "tools/eval/segmentation_metrics.h"
 
 namespace {
@@ -475,6 +476,28 @@ int RunObjects(const Args& args) {
   return Finish(j, args);
 }
 
+// ---------------------------------------------------------------- points
+
+int RunPoints(const Args& args) {
+  if (!args.Has("est") || !args.Has("gt")) return Fail("points: give --est XYZ --gt XYZ (same frame and units)");
+  std::vector<Eigen::Vector3d> est, gt;
+  Status st = eval::ReadPointsFile(args.Get("est"), &est);
+  if (st.ok()) st = eval::ReadPointsFile(args.Get("gt"), &gt);
+  if (!st.ok()) return Fail(st.message());
+  const double threshold = args.GetDouble("threshold", 0.05);
+  const double max_distance = args.GetDouble("max-distance", 1.0);
+  const eval::ReconstructionError e = eval::CompareToSurface(est, gt, threshold, max_distance);
+  std::printf("reconstruction: %zu points against %zu true samples: accuracy median %.4f m, rmse %.4f m, %d beyond "
+              "%.2f m; completeness %.3f within %.3f m\n",
+              est.size(), gt.size(), e.accuracy.median, e.accuracy.rmse, e.outliers, max_distance, e.completeness,
+              threshold);
+  Json j = Json::Object();
+  j.Set("metric", "points").Set("points", est.size()).Set("truth_points", gt.size());
+  j.Set("accuracy_median_m", e.accuracy.median).Set("accuracy_rmse_m", e.accuracy.rmse);
+  j.Set("outliers", e.outliers).Set("completeness", e.completeness).Set("threshold_m", threshold);
+  return Finish(j, args);
+}
+
 // ---------------------------------------------------------------- perturb
 
 int RunPerturb(const Args& args) {
@@ -610,6 +633,8 @@ void Usage() {
            --features FILE ("stem u v moving" per line) [--root DIR]
   objects  per-object trajectory / scale / depth errors and predicted-volume hit rate
            --est-log LOG --gt-log LOG [--horizon-us N] [--align sim3|se3] [--max-match-m M]
+  points   reconstruction accuracy / completeness against ground-truth surface points
+           --est XYZ --gt XYZ (e.g. <sequence>/points/<id>.txt) [--threshold 0.05] [--max-distance 1.0]
   perturb  write a trajectory with a known similarity and noise (expected ATE printed)
            --in GT.tum --out EST.tum [--scale S] [--rot-deg A] [--axis x,y,z] [--trans x,y,z] [--noise M] [--seed N] [--no-exact]
   perturb-labels  write labels with a known number of errors
@@ -633,6 +658,7 @@ int main(int argc, char** argv) {
   if (cmd == "masks") return RunMasks(args);
   if (cmd == "objects") return RunObjects(args);
   if (cmd == "camvid") return RunCamVid(args);
+  if (cmd == "points") return RunPoints(args);
   if (cmd == "perturb") return RunPerturb(args);
   if (cmd == "perturb-labels") return RunPerturbLabels(args);
   if (cmd == "datasets") return RunDatasets(args);

@@ -14,6 +14,7 @@
 #include "mbslam/ground_truth_t.hpp"
 #include "mbslam/image_t.hpp"
 #include "mbslam/odometry_t.hpp"
+#include "tools/eval/datasets.h"
 #include "tools/eval/trajectory.h"
 
 namespace mbslam {
@@ -165,6 +166,24 @@ TEST(SequenceWriter, FolderAndLogMatchTheSimulator) {
     }
   }
   EXPECT_TRUE(calibration_before_first_image);
+
+  // The evaluation toolkit reads the folder back.
+  eval::SequenceFolder folder;
+  ASSERT_TRUE(eval::ReadSequenceFolder(dir, &folder).ok());
+  EXPECT_EQ(folder.utimes.size(), 40u);
+  EXPECT_EQ(folder.utimes[7], sim->FrameUtime(7));
+  EXPECT_EQ(folder.camera.size(), 40u);
+  EXPECT_EQ(folder.images.size(), 40u);
+  EXPECT_EQ(folder.masks.size(), 40u);
+  EXPECT_EQ(folder.depths.size(), 40u);
+  EXPECT_DOUBLE_EQ(folder.intrinsics.fx, sim->intrinsics().fx);
+  ASSERT_EQ(folder.bodies.size(), 3u);
+  EXPECT_EQ(folder.bodies.at(2).name, "car");
+  EXPECT_NEAR(folder.bodies.at(2).extent.x(), 4.2, 1e-9);
+  EXPECT_EQ(folder.bodies.at(2).poses.size(), 40u);
+  ASSERT_EQ(folder.points.count(0), 1u);
+  EXPECT_EQ(folder.points.at(0).size(), sim->SurfacePoints(0).size());
+  EXPECT_LT((folder.points.at(1)[5] - sim->SurfacePoints(1)[5]).norm(), 1e-5);
   EXPECT_EQ(count["CAMERA_IMAGE"], 40);
   EXPECT_EQ(count["GROUND_TRUTH"], 40);
   EXPECT_EQ(count["CAMERA_CALIBRATION"], 3);  // t = 0, 0.5 s, 1.0 s... of 1.3 s
