@@ -182,7 +182,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     o.track_id = t.id;
     o.uv = t.uv.cast<double>();
     o.xy = intrinsics.PixelToNormalized(o.uv);
-    o.body_id = t.body_id;
+    o.body_id = options_.slam.use_segmentation ? t.body_id : 0;
     o.is_new = t.is_new;
     slam_frame.observations.push_back(o);
   }
@@ -255,7 +255,13 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   SlamMapUpdate map_update;
   {
     ScopedStageTimer timer(mapping_timer_);
-    map_update = slam_.UpdateMap(slam_frame, body_of);
+    if (options_.slam.use_segmentation) {
+      map_update = slam_.UpdateMap(slam_frame, body_of);
+    } else {
+      std::unordered_map<int64_t, int> all_static;
+      for (const auto& [id, body] : body_of) all_static[id] = 0;
+      map_update = slam_.UpdateMap(slam_frame, all_static);
+    }
   }
   FillCameraPose(slam_pose, &result.camera_pose);
   if (slam_.map().num_keyframes() > 0 &&

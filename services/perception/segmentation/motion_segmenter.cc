@@ -43,7 +43,12 @@ double MotionSegmenter::BayesUpdate(double prior, double likelihood, double para
   const double l = std::clamp(likelihood, 0.0, 1.0);
   const double e = options_.likelihood_tail;
   double log_lr = std::log((l + e) / (1.0 - l + e)) * options_.evidence_weight;
-  if (log_lr > 0.0) log_lr *= std::min(1.0, parallax_px / options_.target_parallax_px);
+  if (log_lr > 0.0) {
+    // Static evidence from a pair with little parallax is discounted (it cannot reveal
+    // a degenerate mover yet), but not to nothing: a wrong early label must be able to
+    // recover.
+    log_lr *= std::clamp(parallax_px / options_.target_parallax_px, options_.min_static_evidence, 1.0);
+  }
   const double odds = prior / (1.0 - prior) * std::exp(log_lr);
   const double p = odds / (1.0 + odds);
   return std::clamp(p, 1.0 - options_.p_clamp, options_.p_clamp);

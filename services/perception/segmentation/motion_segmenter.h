@@ -45,6 +45,7 @@ struct SegmentationOptions {
   double target_parallax_px = 12.0; // the reference goes back until static tracks moved this much (px)
   double evidence_weight = 0.5;     // exponent on each image's likelihood ratio (overlapping windows)
   double likelihood_tail = 0.05;    // added to both hypotheses' likelihoods: one bad match is not proof
+  double min_static_evidence = 0.25;  // static evidence of a low-parallax pair keeps at least this weight
   double p_clamp = 0.98;            // posterior clamp, lets a label switch within a few images
   double static_enter = 0.6;        // P(static) to become static again
   double static_leave = 0.4;        // P(static) below which a track is moving
@@ -77,6 +78,7 @@ struct SegmentationOptions {
     MBSLAM_CHECK_OPTION_GT(target_parallax_px, 0.0);
     MBSLAM_CHECK_OPTION(evidence_weight > 0.0 && evidence_weight <= 1.0);
     MBSLAM_CHECK_OPTION(likelihood_tail > 0.0 && likelihood_tail < 1.0);
+    MBSLAM_CHECK_OPTION(min_static_evidence >= 0.0 && min_static_evidence <= 1.0);
     MBSLAM_CHECK_OPTION(p_clamp > 0.5 && p_clamp < 1.0);
     MBSLAM_CHECK_OPTION(static_leave <= static_enter);
     MBSLAM_CHECK_OPTION_GE(min_object_tracks, 2);
@@ -104,6 +106,7 @@ struct SegmentationOptions {
     v("target_parallax_px", &target_parallax_px, "reference goes back until static tracks moved this much (px)");
     v("evidence_weight", &evidence_weight, "exponent on each image's likelihood ratio");
     v("likelihood_tail", &likelihood_tail, "added to both hypotheses' likelihoods (robustness)");
+    v("min_static_evidence", &min_static_evidence, "weight kept by static evidence of low-parallax pairs");
     v("p_clamp", &p_clamp, "posterior clamp");
     v("static_enter", &static_enter, "P(static) to become static");
     v("static_leave", &static_leave, "P(static) below which a track is moving");

@@ -60,6 +60,7 @@ struct SlamOptions {
   int max_keyframes = 200;               // oldest keyframes are culled beyond this (count)
   bool background_ba = true;             // local BA in a back-end thread (realtime); false: inline (deterministic)
   bool use_odometry = true;              // odometry gives the prior motion and the metric scale
+  bool use_segmentation = true;          // feedback from segmentation: moving tracks never enter the map (false = ablation)
   double depth_bound_margin = 0.15;      // known-depth bound: depth * (1 +- margin)
   double frustum_bound_factor = 2.0;     // frustum bound: [min / f, max * f] of map depths around the ray
   std::string map_load_path;             // map loaded at start ("" = none)
@@ -111,6 +112,7 @@ struct SlamOptions {
     v("max_keyframes", &max_keyframes, "keyframes kept (count)");
     v("background_ba", &background_ba, "local BA in a back-end thread (false: inline, deterministic)");
     v("use_odometry", &use_odometry, "odometry as motion prior and metric scale");
+    v("use_segmentation", &use_segmentation, "segmentation feedback: moving tracks stay out of the map (false = ablation)");
     v("depth_bound_margin", &depth_bound_margin, "known-depth bound: depth * (1 +- margin)");
     v("frustum_bound_factor", &frustum_bound_factor, "frustum depth bound: [min / f, max * f]");
     v("map_load_path", &map_load_path, "map loaded at start (\"\" = none)");
