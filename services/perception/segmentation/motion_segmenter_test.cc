@@ -180,9 +180,11 @@ TEST(MotionSegmenter, DegenerateFollowingNeedsTheFlowVectorBound) {
   };
   const auto [recall_fvb, precision_fvb] = run(true);
   const auto [recall_epi, precision_epi] = run(false);
-  EXPECT_GT(recall_fvb, 0.9);
+  // Points close to the epipole stay ambiguous (their flow tells nothing), hence not 1.
+  EXPECT_GT(recall_fvb, 0.85);
   EXPECT_GT(precision_fvb, 0.9);
   EXPECT_LT(recall_epi, 0.5) << "the epipolar constraint alone misses degenerate motion";
+  EXPECT_GT(recall_fvb, recall_epi + 0.4);
   (void)precision_epi;
 }
 
