@@ -40,6 +40,7 @@ label_max=0
 label_failures=0
 pixel_mismatch_off_edge=0
 depth_rel_max=0
+depth_px_max=0
 samples=0
 scenario_json=""
 for s in $("$bin/mbslam-sim" --list | awk '{print $1}'); do
@@ -52,14 +53,16 @@ for s in $("$bin/mbslam-sim" --list | awk '{print $1}'); do
   pm=$(json_get "$f" pixel_label_mismatches)
   pe=$(json_get "$f" pixel_label_mismatches_on_edges)
   dr=$(json_get "$f" depth_max_rel_error)
+  dp=$(json_get "$f" depth_max_error_px)
   n=$(json_get "$f" samples_visible)
-  printf "  %-18s visible samples %6s  reprojection max %-10s px  label max %-8s px  label failures %s  pixel mismatches %s (%s on silhouettes)  depth rel err %s\n" \
-    "$s" "$n" "$r" "$l" "$lf" "$pm" "$pe" "$dr"
+  printf "  %-18s visible samples %6s  reprojection max %-10s px  label max %-8s px  label failures %s  pixel mismatches %s (%s on silhouettes)  depth rel err %s (%s px)\n" \
+    "$s" "$n" "$r" "$l" "$lf" "$pm" "$pe" "$dr" "$dp"
   reproj_max=$(max_of "$reproj_max" "$r")
   label_max=$(max_of "$label_max" "$l")
   label_failures=$((label_failures + lf))
   pixel_mismatch_off_edge=$((pixel_mismatch_off_edge + pm - pe))
   depth_rel_max=$(max_of "$depth_rel_max" "$dr")
+  depth_px_max=$(max_of "$depth_px_max" "$dp")
   samples=$((samples + n))
   scenario_json+="\"$s\": $r, "
 done
@@ -122,7 +125,7 @@ done
 # Pass: sub-pixel reprojection and label errors within 0.5 px, no mask / depth mismatch
 # away from silhouettes, and the known answers recovered to numerical precision.
 pass=$(awk -v r="$reproj_max" -v l="$label_max" -v lf="$label_failures" -v pm="$pixel_mismatch_off_edge" \
-  -v a="$ate_err" -v m="$mis_err" \
-  'BEGIN { print (r <= 0.5 && l <= 0.5 && lf == 0 && pm == 0 && a < 1e-6 && m < 1e-12) ? "true" : "false" }')
+  -v dp="$depth_px_max" -v a="$ate_err" -v m="$mis_err" \
+  'BEGIN { print (r <= 0.5 && l <= 0.5 && lf == 0 && pm == 0 && dp <= 0.5 && a < 1e-6 && m < 1e-12) ? "true" : "false" }')
 echo "summary: gt reprojection max $reproj_max px, label max $label_max px ($label_failures failures), ATE known-answer error $ate_err m, misclassification known-answer error $mis_err"
-echo "{\"gt_reprojection_max_px\": $reproj_max, \"ate_known_answer_error\": $ate_err, \"misclassification_known_answer_error\": $mis_err, \"gt_label_max_px\": $label_max, \"gt_label_failures\": $label_failures, \"gt_pixel_mismatches_off_silhouette\": $pixel_mismatch_off_edge, \"gt_depth_max_rel_error\": $depth_rel_max, \"gt_samples_checked\": $samples, \"rpe_self_m\": $rpe_self, \"size\": \"$size\", \"per_scenario_reprojection_max_px\": {${scenario_json%, }}, \"pass\": $pass}"
+echo "{\"gt_reprojection_max_px\": $reproj_max, \"ate_known_answer_error\": $ate_err, \"misclassification_known_answer_error\": $mis_err, \"gt_label_max_px\": $label_max, \"gt_label_failures\": $label_failures, \"gt_pixel_mismatches_off_silhouette\": $pixel_mismatch_off_edge, \"gt_depth_max_rel_error\": $depth_rel_max, \"gt_depth_max_error_px\": $depth_px_max, \"gt_samples_checked\": $samples, \"rpe_self_m\": $rpe_self, \"size\": \"$size\", \"per_scenario_reprojection_max_px\": {${scenario_json%, }}, \"pass\": $pass}"

@@ -7,10 +7,13 @@
 namespace mbslam {
 namespace eval {
 
-Status UmeyamaAlignment(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst,
-                        bool with_scale, Sim3d* dst_from_src) {
+Status UmeyamaAlignment(const std::vector<Eigen::Vector3d>& src,
+                        const std::vector<Eigen::Vector3d>& dst, bool with_scale,
+                        Sim3d* dst_from_src) {
   if (src.size() != dst.size()) return Status::Error("alignment: point sets differ in size");
-  if (src.size() < 3) return Status::Error("alignment: needs at least 3 point pairs, got " + std::to_string(src.size()));
+  if (src.size() < 3)
+    return Status::Error("alignment: needs at least 3 point pairs, got " +
+                         std::to_string(src.size()));
   const double n = static_cast<double>(src.size());
   Eigen::Vector3d mu_src = Eigen::Vector3d::Zero(), mu_dst = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < src.size(); ++i) {

@@ -16,8 +16,9 @@ namespace eval {
 
 // with_scale = false gives the best rigid transform (scale 1). Needs >= 3 points that
 // are not all on one line (>= 1 point for a translation-only problem is not supported).
-Status UmeyamaAlignment(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst,
-                        bool with_scale, Sim3d* dst_from_src);
+Status UmeyamaAlignment(const std::vector<Eigen::Vector3d>& src,
+                        const std::vector<Eigen::Vector3d>& dst, bool with_scale,
+                        Sim3d* dst_from_src);
 
 }  // namespace eval
 }  // namespace mbslam

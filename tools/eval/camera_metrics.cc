@@ -10,18 +10,25 @@ namespace eval {
 
 const char* AlignmentName(Alignment a) {
   switch (a) {
-    case Alignment::kNone: return "none";
-    case Alignment::kSE3: return "se3";
-    case Alignment::kSim3: return "sim3";
+    case Alignment::kNone:
+      return "none";
+    case Alignment::kSE3:
+      return "se3";
+    case Alignment::kSim3:
+      return "sim3";
   }
   return "unknown";
 }
 
 bool ParseAlignment(const std::string& text, Alignment* a) {
-  if (text == "none") *a = Alignment::kNone;
-  else if (text == "se3") *a = Alignment::kSE3;
-  else if (text == "sim3") *a = Alignment::kSim3;
-  else return false;
+  if (text == "none")
+    *a = Alignment::kNone;
+  else if (text == "se3")
+    *a = Alignment::kSE3;
+  else if (text == "sim3")
+    *a = Alignment::kSim3;
+  else
+    return false;
   return true;
 }
 
@@ -48,7 +55,8 @@ ErrorStats ErrorStats::From(std::vector<double> values) {
   return s;
 }
 
-Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions& options, AteResult* result) {
+Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions& options,
+                  AteResult* result) {
   if (!options.Check()) return Status::Error("ATE options: " + LastOptionError());
   Alignment alignment;
   ParseAlignment(options.alignment, &alignment);
@@ -57,8 +65,8 @@ Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions&
   result->num_gt = static_cast<int>(gt.size());
   result->pairs = AssociateByTime(est, gt, options.max_time_diff_us);
   if (result->pairs.empty()) {
-    return Status::Error("ATE: no estimate pose within " + std::to_string(options.max_time_diff_us) +
-                         " µs of a ground-truth pose");
+    return Status::Error("ATE: no estimate pose within " +
+                         std::to_string(options.max_time_diff_us) + " µs of a ground-truth pose");
   }
   std::vector<Eigen::Vector3d> src, dst;
   for (const auto& p : result->pairs) {
@@ -67,7 +75,8 @@ Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions&
   }
   if (alignment != Alignment::kNone) {
     MBSLAM_RETURN_IF_ERROR(
-        UmeyamaAlignment(src, dst, alignment == Alignment::kSim3, &result->gt_from_est).WithContext("ATE"));
+        UmeyamaAlignment(src, dst, alignment == Alignment::kSim3, &result->gt_from_est)
+            .WithContext("ATE"));
   }
   std::vector<double> rot;
   for (const auto& p : result->pairs) {
@@ -81,8 +90,9 @@ Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions&
   return Status::Ok();
 }
 
-Status ComputeRpe(const Trajectory& est, const Trajectory& gt, const std::vector<AssociatedPair>& pairs,
-                  const RpeOptions& options, RpeResult* result) {
+Status ComputeRpe(const Trajectory& est, const Trajectory& gt,
+                  const std::vector<AssociatedPair>& pairs, const RpeOptions& options,
+                  RpeResult* result) {
   if (!options.Check()) return Status::Error("RPE options: " + LastOptionError());
   std::vector<double> trans, rot;
   for (size_t i = 0; i < pairs.size(); ++i) {
@@ -106,7 +116,8 @@ Status ComputeRpe(const Trajectory& est, const Trajectory& gt, const std::vector
   return Status::Ok();
 }
 
-double FractionTracked(const Trajectory& tracked_est, const Trajectory& gt, int64_t max_time_diff_us) {
+double FractionTracked(const Trajectory& tracked_est, const Trajectory& gt,
+                       int64_t max_time_diff_us) {
   if (gt.empty()) return 0.0;
   return static_cast<double>(AssociateByTime(tracked_est, gt, max_time_diff_us).size()) /
          static_cast<double>(gt.size());

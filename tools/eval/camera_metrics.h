@@ -33,7 +33,7 @@ struct ErrorStats {
 };
 
 struct AteOptions {
-  std::string alignment = "sim3";    // none | se3 | sim3 (sim3 for monocular, up-to-scale estimates)
+  std::string alignment = "sim3";  // none | se3 | sim3 (sim3 for monocular, up-to-scale estimates)
   int64_t max_time_diff_us = 20000;  // largest time difference of associated poses (µs)
 
   bool Check() const {
@@ -50,23 +50,24 @@ struct AteOptions {
 };
 
 struct AteResult {
-  int num_est = 0;                   // poses in the estimate (count)
-  int num_gt = 0;                    // poses in the ground truth (count)
+  int num_est = 0;  // poses in the estimate (count)
+  int num_gt = 0;   // poses in the ground truth (count)
   std::vector<AssociatedPair> pairs;
-  Sim3d gt_from_est;                 // the alignment applied to the estimate
-  ErrorStats translation;            // |t_gt - t_aligned_est| (m, ground-truth units)
-  ErrorStats rotation_deg;           // angle of R_gt^T R_aligned_est (deg)
-  std::vector<double> errors;        // translation error per pair (m)
-  Trajectory est_aligned;            // aligned estimate poses, one per pair
+  Sim3d gt_from_est;           // the alignment applied to the estimate
+  ErrorStats translation;      // |t_gt - t_aligned_est| (m, ground-truth units)
+  ErrorStats rotation_deg;     // angle of R_gt^T R_aligned_est (deg)
+  std::vector<double> errors;  // translation error per pair (m)
+  Trajectory est_aligned;      // aligned estimate poses, one per pair
 };
 
 // Associates by time, aligns (Umeyama on the camera centres) and measures.
-Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions& options, AteResult* result);
+Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions& options,
+                  AteResult* result);
 
 struct RpeOptions {
-  int delta_frames = 1;        // compare poses this many associated pairs apart (count) ...
-  int64_t delta_us = 0;        // ... or, if > 0, this far apart in time (µs)
-  double est_scale = 1.0;      // multiplies the estimate's translations (e.g. the Sim(3) scale)
+  int delta_frames = 1;    // compare poses this many associated pairs apart (count) ...
+  int64_t delta_us = 0;    // ... or, if > 0, this far apart in time (µs)
+  double est_scale = 1.0;  // multiplies the estimate's translations (e.g. the Sim(3) scale)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(delta_frames, 1);
@@ -88,11 +89,13 @@ struct RpeResult {
 };
 
 // E_ij = (gt_i^-1 gt_j)^-1 (est_i^-1 est_j), over associated pairs i, j.
-Status ComputeRpe(const Trajectory& est, const Trajectory& gt, const std::vector<AssociatedPair>& pairs,
-                  const RpeOptions& options, RpeResult* result);
+Status ComputeRpe(const Trajectory& est, const Trajectory& gt,
+                  const std::vector<AssociatedPair>& pairs, const RpeOptions& options,
+                  RpeResult* result);
 
 // Fraction of ground-truth frames with an associated tracked estimate.
-double FractionTracked(const Trajectory& tracked_est, const Trajectory& gt, int64_t max_time_diff_us);
+double FractionTracked(const Trajectory& tracked_est, const Trajectory& gt,
+                       int64_t max_time_diff_us);
 
 }  // namespace eval
 }  // namespace mbslam

@@ -23,7 +23,8 @@ Trajectory MakeTruth(int n) {
     const Eigen::Vector3d p(4.0 * std::cos(s), 3.0 * std::sin(s), 0.5 * std::sin(3.0 * s) + 1.5);
     const Eigen::Quaterniond q(Eigen::AngleAxisd(s + 0.3 * std::sin(s), Eigen::Vector3d::UnitZ()) *
                                Eigen::AngleAxisd(0.2 * std::cos(2 * s), Eigen::Vector3d::UnitX()));
-    t.push_back({1600000000000000 + static_cast<int64_t>(std::llround(i * 1e6 / 30.0)), Rigid3d(q, p)});
+    t.push_back(
+        {1600000000000000 + static_cast<int64_t>(std::llround(i * 1e6 / 30.0)), Rigid3d(q, p)});
   }
   return t;
 }
@@ -58,14 +59,16 @@ TEST(Umeyama, RecoversSimilarityExactly) {
   EXPECT_DOUBLE_EQ(est.scale, 1.0);
   EXPECT_LT(est.rotation.angularDistance(rigid.rotation), 1e-12);
   // A reflection is never returned.
-  for (size_t i = 0; i < src.size(); ++i) dst[i] = Eigen::Vector3d(src[i].x(), src[i].y(), -src[i].z());
+  for (size_t i = 0; i < src.size(); ++i)
+    dst[i] = Eigen::Vector3d(src[i].x(), src[i].y(), -src[i].z());
   ASSERT_TRUE(UmeyamaAlignment(src, dst, true, &est).ok());
   EXPECT_NEAR(est.rotation.toRotationMatrix().determinant(), 1.0, 1e-12);
   // Degenerate inputs are refused.
   EXPECT_FALSE(UmeyamaAlignment({src[0], src[1]}, {dst[0], dst[1]}, true, &est).ok());
-  EXPECT_FALSE(UmeyamaAlignment({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(2, 2, 2)},
-                                {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(2, 2, 2)}, true,
-                                &est)
+  EXPECT_FALSE(UmeyamaAlignment(
+                   {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(2, 2, 2)},
+                   {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(2, 2, 2)},
+                   true, &est)
                    .ok());
 }
 

@@ -1,7 +1,7 @@
 #include "tools/eval/datasets.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -62,7 +62,9 @@ std::string DataSetPath(const std::string& name) {
   return IsDir(path) ? path : "";
 }
 
-int TrackSet::NumGroups() const { return static_cast<int>(std::set<int>(labels.begin(), labels.end()).size()); }
+int TrackSet::NumGroups() const {
+  return static_cast<int>(std::set<int>(labels.begin(), labels.end()).size());
+}
 
 Status ParseTracks(const std::string& text, TrackSet* set) {
   std::istringstream in(text);
@@ -72,15 +74,17 @@ Status ParseTracks(const std::string& text, TrackSet* set) {
   }
   set->labels.assign(static_cast<size_t>(points), 0);
   for (int i = 0; i < points; ++i) {
-    if (!(in >> set->labels[static_cast<size_t>(i)])) return Status::Error("tracks: too few labels");
+    if (!(in >> set->labels[static_cast<size_t>(i)]))
+      return Status::Error("tracks: too few labels");
   }
-  set->tracks.assign(static_cast<size_t>(points), std::vector<Eigen::Vector2d>(static_cast<size_t>(frames)));
+  set->tracks.assign(static_cast<size_t>(points),
+                     std::vector<Eigen::Vector2d>(static_cast<size_t>(frames)));
   for (int i = 0; i < points; ++i) {
     for (int f = 0; f < frames; ++f) {
       std::string xs, ys;
       if (!(in >> xs >> ys)) {
-        return Status::Error("tracks: point " + std::to_string(i) + " has fewer than " + std::to_string(frames) +
-                             " positions");
+        return Status::Error("tracks: point " + std::to_string(i) + " has fewer than " +
+                             std::to_string(frames) + " positions");
       }
       // strtod reads "nan" as NaN.
       auto& p = set->tracks[static_cast<size_t>(i)][static_cast<size_t>(f)];
@@ -101,7 +105,8 @@ Status ReadTracksFile(const std::string& path, TrackSet* set) {
   MBSLAM_RETURN_IF_ERROR(ReadFileToString(path, &text));
   std::string name = fs::path(path).filename().string();
   const std::string suffix = ".tracks.txt";
-  if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+  if (name.size() > suffix.size() &&
+      name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
     name.resize(name.size() - suffix.size());
   }
   set->name = name;
@@ -109,9 +114,10 @@ Status ReadTracksFile(const std::string& path, TrackSet* set) {
 }
 
 Status WriteTracksFile(const std::string& path, const TrackSet& set) {
-  std::string text = std::to_string(set.num_points()) + " " + std::to_string(set.num_frames()) + " " +
-                     std::to_string(set.width) + " " + std::to_string(set.height) + "\n";
-  for (size_t i = 0; i < set.labels.size(); ++i) text += (i ? " " : "") + std::to_string(set.labels[i]);
+  std::string text = std::to_string(set.num_points()) + " " + std::to_string(set.num_frames()) +
+                     " " + std::to_string(set.width) + " " + std::to_string(set.height) + "\n";
+  for (size_t i = 0; i < set.labels.size(); ++i)
+    text += (i ? " " : "") + std::to_string(set.labels[i]);
   text += "\n";
   char buf[64];
   for (const auto& track : set.tracks) {
@@ -202,7 +208,8 @@ Status ReadCamVid(const std::string& root, std::vector<CamVidFrame>* frames) {
   frames->clear();
   const std::string images = (fs::path(root) / "images").string();
   const std::string labels = (fs::path(root) / "labels").string();
-  if (!IsDir(images) || !IsDir(labels)) return Status::Error("CamVid: want images/ and labels/ in " + root);
+  if (!IsDir(images) || !IsDir(labels))
+    return Status::Error("CamVid: want images/ and labels/ in " + root);
   for (const auto& label : ListFiles(labels, ".png")) {
     const std::string image = (fs::path(images) / fs::path(label).filename()).string();
     if (!IsFile(image)) return Status::Error("CamVid: no image for " + label);
@@ -224,7 +231,8 @@ void CamVidFeatureStats::Add(const CamVidFeatureStats& o) {
   movable_fraction = moving > 0 ? static_cast<double>(on_movable) / moving : 0.0;
 }
 
-CamVidFeatureStats CamVidMovingFeatureStats(const std::vector<LabelledFeature>& features, const cv::Mat& labels) {
+CamVidFeatureStats CamVidMovingFeatureStats(const std::vector<LabelledFeature>& features,
+                                            const cv::Mat& labels) {
   CamVidFeatureStats s;
   for (const auto& f : features) {
     if (!f.moving) continue;
@@ -232,9 +240,12 @@ CamVidFeatureStats CamVidMovingFeatureStats(const std::vector<LabelledFeature>& 
     if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows) continue;
     const int label = labels.at<uint8_t>(y, x);
     ++s.moving;
-    if (IsCamVidStaticClass(label)) ++s.on_static;
-    else if (IsCamVidMovableClass(label)) ++s.on_movable;
-    else ++s.on_void;
+    if (IsCamVidStaticClass(label))
+      ++s.on_static;
+    else if (IsCamVidMovableClass(label))
+      ++s.on_movable;
+    else
+      ++s.on_void;
   }
   s.Add(CamVidFeatureStats());  // computes the fractions
   return s;
@@ -242,7 +253,8 @@ CamVidFeatureStats CamVidMovingFeatureStats(const std::vector<LabelledFeature>& 
 
 Status ReadTumSubset(const std::string& root, TumSubset* subset) {
   *subset = TumSubset();
-  MBSLAM_RETURN_IF_ERROR(ReadTumTrajectory((fs::path(root) / "truth_cam_poses.txt").string(), &subset->truth));
+  MBSLAM_RETURN_IF_ERROR(
+      ReadTumTrajectory((fs::path(root) / "truth_cam_poses.txt").string(), &subset->truth));
   const auto images = ListFiles((fs::path(root) / "raw_imgs").string(), "_rgb_raw.jpg");
   const auto depths = ListFiles((fs::path(root) / "depth_imgs").string(), "_depth_raw.png");
   if (images.size() != subset->truth.size()) {
@@ -262,14 +274,15 @@ Status ReadTumSubset(const std::string& root, TumSubset* subset) {
   return Status::Ok();
 }
 
-Status ReadTartanAirSubset(const std::string& root, int64_t frame_period_us, TartanAirSubset* subset) {
+Status ReadTartanAirSubset(const std::string& root, int64_t frame_period_us,
+                           TartanAirSubset* subset) {
   *subset = TartanAirSubset();
-  MBSLAM_RETURN_IF_ERROR(
-      ReadTartanAirPoses((fs::path(root) / "pose_left.txt").string(), frame_period_us, &subset->truth));
+  MBSLAM_RETURN_IF_ERROR(ReadTartanAirPoses((fs::path(root) / "pose_left.txt").string(),
+                                            frame_period_us, &subset->truth));
   subset->images = ListFiles((fs::path(root) / "images").string(), "_left.jpg");
   if (subset->images.size() != subset->truth.size()) {
-    return Status::Error("TartanAir subset: " + std::to_string(subset->images.size()) + " images but " +
-                         std::to_string(subset->truth.size()) + " poses");
+    return Status::Error("TartanAir subset: " + std::to_string(subset->images.size()) +
+                         " images but " + std::to_string(subset->truth.size()) + " poses");
   }
   CameraIntrinsics& K = subset->intrinsics;
   K.name = "tartanair";
@@ -284,7 +297,8 @@ Status ReadTartanAirSubset(const std::string& root, int64_t frame_period_us, Tar
 Status ReadSequenceFolder(const std::string& dir, SequenceFolder* seq) {
   *seq = SequenceFolder();
   const fs::path root(dir);
-  MBSLAM_RETURN_IF_ERROR(LoadCameraIntrinsics((root / "calibration.yaml").string(), &seq->intrinsics));
+  MBSLAM_RETURN_IF_ERROR(
+      LoadCameraIntrinsics((root / "calibration.yaml").string(), &seq->intrinsics));
   std::string text;
   MBSLAM_RETURN_IF_ERROR(ReadFileToString((root / "timestamps.txt").string(), &text));
   std::istringstream in(text);
@@ -329,8 +343,8 @@ Status ReadSequenceFolder(const std::string& dir, SequenceFolder* seq) {
       } catch (const YAML::Exception& e) {
         return Status::Error(objects_yaml + ": " + e.what());
       }
-      MBSLAM_RETURN_IF_ERROR(
-          ReadTumTrajectory((root / "objects" / (std::to_string(body.id) + ".tum")).string(), &body.poses));
+      MBSLAM_RETURN_IF_ERROR(ReadTumTrajectory(
+          (root / "objects" / (std::to_string(body.id) + ".tum")).string(), &body.poses));
       seq->bodies[body.id] = std::move(body);
     }
   }

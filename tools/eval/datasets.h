@@ -33,17 +33,18 @@ std::string DataSetPath(const std::string& name);
 // ground-truth labels, then P lines "x1 y1 ... xF yF" (px; "nan nan" = not visible).
 struct TrackSet {
   std::string name;
-  int width = 0;                                      // px
-  int height = 0;                                     // px
-  std::vector<int> labels;                            // per point: true motion group
-  std::vector<std::vector<Eigen::Vector2d>> tracks;   // [point][frame], NaN = not visible
+  int width = 0;                                     // px
+  int height = 0;                                    // px
+  std::vector<int> labels;                           // per point: true motion group
+  std::vector<std::vector<Eigen::Vector2d>> tracks;  // [point][frame], NaN = not visible
 
   int num_points() const { return static_cast<int>(tracks.size()); }
   int num_frames() const { return tracks.empty() ? 0 : static_cast<int>(tracks.front().size()); }
   int NumGroups() const;
 };
 Status ParseTracks(const std::string& text, TrackSet* set);
-Status ReadTracksFile(const std::string& path, TrackSet* set);  // name = file name without .tracks.txt
+Status ReadTracksFile(const std::string& path,
+                      TrackSet* set);  // name = file name without .tracks.txt
 Status WriteTracksFile(const std::string& path, const TrackSet& set);
 // Every *.tracks.txt in a folder, sorted by name.
 Status ReadTracksFolder(const std::string& dir, std::vector<TrackSet>* sets);
@@ -68,8 +69,18 @@ struct CamVidFrame {
   std::string label;  // labels/<name>.png (class per pixel)
 };
 enum CamVidClass {
-  kCamVidSky = 0, kCamVidBuilding = 1, kCamVidPole = 2, kCamVidRoad = 3, kCamVidPavement = 4, kCamVidTree = 5,
-  kCamVidSign = 6, kCamVidFence = 7, kCamVidCar = 8, kCamVidPedestrian = 9, kCamVidBicyclist = 10, kCamVidVoid = 11
+  kCamVidSky = 0,
+  kCamVidBuilding = 1,
+  kCamVidPole = 2,
+  kCamVidRoad = 3,
+  kCamVidPavement = 4,
+  kCamVidTree = 5,
+  kCamVidSign = 6,
+  kCamVidFence = 7,
+  kCamVidCar = 8,
+  kCamVidPedestrian = 9,
+  kCamVidBicyclist = 10,
+  kCamVidVoid = 11
 };
 Status ReadCamVid(const std::string& root, std::vector<CamVidFrame>* frames);
 bool IsCamVidStaticClass(int label);   // sky, building, pole, road, pavement, tree, sign, fence
@@ -77,15 +88,16 @@ bool IsCamVidMovableClass(int label);  // car, pedestrian, bicyclist
 
 // Where the features labelled moving fall in a CamVid label image.
 struct CamVidFeatureStats {
-  int moving = 0;       // features labelled moving (inside the image) (count)
-  int on_static = 0;    // ... on static classes: false detections (count)
-  int on_movable = 0;   // ... on cars, pedestrians, bicyclists (count)
-  int on_void = 0;      // ... on void / unknown labels (count)
+  int moving = 0;                 // features labelled moving (inside the image) (count)
+  int on_static = 0;              // ... on static classes: false detections (count)
+  int on_movable = 0;             // ... on cars, pedestrians, bicyclists (count)
+  int on_void = 0;                // ... on void / unknown labels (count)
   double static_fraction = 0.0;   // on_static / moving (0 if none)
   double movable_fraction = 0.0;  // on_movable / moving (0 if none)
   void Add(const CamVidFeatureStats& other);
 };
-CamVidFeatureStats CamVidMovingFeatureStats(const std::vector<LabelledFeature>& features, const cv::Mat& labels);
+CamVidFeatureStats CamVidMovingFeatureStats(const std::vector<LabelledFeature>& features,
+                                            const cv::Mat& labels);
 
 // ---------------------------------------------------------------- TUM RGB-D subset
 struct TumSubset {
@@ -98,23 +110,25 @@ Status ReadTumSubset(const std::string& root, TumSubset* subset);
 
 // ---------------------------------------------------------------- TartanAir subset
 struct TartanAirSubset {
-  Trajectory truth;                 // world_from_cam (world in NED, camera x right, y down, z forward)
+  Trajectory truth;  // world_from_cam (world in NED, camera x right, y down, z forward)
   std::vector<std::string> images;  // images/NNNNNN_left.jpg
   CameraIntrinsics intrinsics;      // fx = fy = 320, cx = 320, cy = 240
 };
 // Frame i gets utime = i * frame_period_us (the data has no timestamps).
-Status ReadTartanAirSubset(const std::string& root, int64_t frame_period_us, TartanAirSubset* subset);
+Status ReadTartanAirSubset(const std::string& root, int64_t frame_period_us,
+                           TartanAirSubset* subset);
 
 // ---------------------------------------------------------------- simulator sequence folder
 struct SequenceFolder {
-  CameraIntrinsics intrinsics;       // calibration.yaml
-  std::vector<int64_t> utimes;       // timestamps.txt, per frame
-  Trajectory camera;                 // cam_trajectory.tum
-  std::map<int, BodyTruth> bodies;   // objects/<id>.tum + objects.yaml
-  std::vector<std::string> images;   // images/NNNNNN.png
-  std::vector<std::string> masks;    // masks/NNNNNN.png (may be empty)
-  std::vector<std::string> depths;   // depth/NNNNNN.exr|png (may be empty)
-  std::map<int, std::vector<Eigen::Vector3d>> points;  // points/<id>.txt: surface samples, body frame
+  CameraIntrinsics intrinsics;      // calibration.yaml
+  std::vector<int64_t> utimes;      // timestamps.txt, per frame
+  Trajectory camera;                // cam_trajectory.tum
+  std::map<int, BodyTruth> bodies;  // objects/<id>.tum + objects.yaml
+  std::vector<std::string> images;  // images/NNNNNN.png
+  std::vector<std::string> masks;   // masks/NNNNNN.png (may be empty)
+  std::vector<std::string> depths;  // depth/NNNNNN.exr|png (may be empty)
+  std::map<int, std::vector<Eigen::Vector3d>>
+      points;  // points/<id>.txt: surface samples, body frame
 };
 Status ReadSequenceFolder(const std::string& dir, SequenceFolder* sequence);
 

@@ -4,8 +4,8 @@
 #include "tools/eval/datasets.h"
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 #include <unistd.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -17,11 +17,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-#define REQUIRE_DATA(name, var)                                                                   \
-  const std::string var = DataSetPath(name);                                                     \
-  if (var.empty()) {                                                                             \
-    GTEST_SKIP() << "data set '" << name << "' not found under " << DataRoot()                   \
-                 << " (set MBSLAM_DATA or put ../shared/data next to the repository)";           \
+#define REQUIRE_DATA(name, var)                                                        \
+  const std::string var = DataSetPath(name);                                           \
+  if (var.empty()) {                                                                   \
+    GTEST_SKIP() << "data set '" << name << "' not found under " << DataRoot()         \
+                 << " (set MBSLAM_DATA or put ../shared/data next to the repository)"; \
   }
 
 TEST(Tracks, ParseWriteAndFolder) {

@@ -59,22 +59,24 @@ TEST_F(EvalCli, PerturbThenAteRecoversTheKnownAnswer) {
   Trajectory gt;
   for (int i = 0; i < 200; ++i) {
     const double s = 0.04 * i;
-    gt.push_back({1600000000000000 + i * 33333,
-                  Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(s, Eigen::Vector3d::UnitZ())),
-                          Eigen::Vector3d(3 * std::cos(s), 2 * std::sin(s), 0.3 * std::sin(2 * s)))});
+    gt.push_back(
+        {1600000000000000 + i * 33333,
+         Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(s, Eigen::Vector3d::UnitZ())),
+                 Eigen::Vector3d(3 * std::cos(s), 2 * std::sin(s), 0.3 * std::sin(2 * s)))});
   }
   ASSERT_TRUE(WriteTumTrajectory(Path("gt.tum"), gt).ok());
   Json perturb;
-  ASSERT_EQ(RunEval("perturb --in " + Path("gt.tum") + " --out " + Path("est.tum") +
-                    " --scale 0.25 --rot-deg 40 --axis 1,2,3 --trans 1,-2,0.5 --noise 0.02 --seed 3",
-                &perturb),
-            0);
+  ASSERT_EQ(
+      RunEval("perturb --in " + Path("gt.tum") + " --out " + Path("est.tum") +
+                  " --scale 0.25 --rot-deg 40 --axis 1,2,3 --trans 1,-2,0.5 --noise 0.02 --seed 3",
+              &perturb),
+      0);
   const double expected = perturb.Find("expected_ate_sim3_m")->AsDouble();
   EXPECT_GT(expected, 0.02);
   Json ate;
-  ASSERT_EQ(RunEval("ate --est " + Path("est.tum") + " --gt " + Path("gt.tum") + " --plot " + Path("plot.png") +
-                    " --json " + Path("ate.json"),
-                &ate),
+  ASSERT_EQ(RunEval("ate --est " + Path("est.tum") + " --gt " + Path("gt.tum") + " --plot " +
+                        Path("plot.png") + " --json " + Path("ate.json"),
+                    &ate),
             0);
   // TUM files carry 9 decimals: the answer is exact to ~1e-8 m.
   EXPECT_NEAR(ate.Find("ate_rmse_m")->AsDouble(), expected, 1e-7);
@@ -85,11 +87,15 @@ TEST_F(EvalCli, PerturbThenAteRecoversTheKnownAnswer) {
   EXPECT_TRUE(fs::exists(Path("ate.json")));
   // SE(3) alignment cannot undo the scale.
   Json se3;
-  ASSERT_EQ(RunEval("ate --est " + Path("est.tum") + " --gt " + Path("gt.tum") + " --align se3", &se3), 0);
+  ASSERT_EQ(
+      RunEval("ate --est " + Path("est.tum") + " --gt " + Path("gt.tum") + " --align se3", &se3),
+      0);
   EXPECT_GT(se3.Find("ate_rmse_m")->AsDouble(), 10 * expected);
   // Bad input fails with a message, not a crash.
   EXPECT_NE(RunEval("ate --est " + Path("missing.tum") + " --gt " + Path("gt.tum"), nullptr), 0);
-  EXPECT_NE(RunEval("ate --est " + Path("est.tum") + " --gt " + Path("gt.tum") + " --bogus 1", nullptr), 0);
+  EXPECT_NE(
+      RunEval("ate --est " + Path("est.tum") + " --gt " + Path("gt.tum") + " --bogus 1", nullptr),
+      0);
   EXPECT_NE(RunEval("no-such-command", nullptr), 0);
 }
 
@@ -101,8 +107,9 @@ TEST_F(EvalCli, PerturbLabelsThenSegRecoversTheKnownAnswer) {
     std::fclose(f);
   }
   Json p;
-  ASSERT_EQ(RunEval("perturb-labels --truth " + Path("truth.txt") + " --out " + Path("pred.txt") + " --wrong 9 --split 4",
-                &p),
+  ASSERT_EQ(RunEval("perturb-labels --truth " + Path("truth.txt") + " --out " + Path("pred.txt") +
+                        " --wrong 9 --split 4",
+                    &p),
             0);
   EXPECT_EQ(p.Find("expected_errors")->AsDouble(), 13.0);
   Json seg;

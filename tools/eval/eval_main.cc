@@ -114,7 +114,11 @@ int Finish(const Json& json, const Args& args) {
 
 Json StatsJson(const eval::ErrorStats& s) {
   Json j = Json::Object();
-  j.Set("rmse", s.rmse).Set("mean", s.mean).Set("median", s.median).Set("std", s.std).Set("min", s.min);
+  j.Set("rmse", s.rmse)
+      .Set("mean", s.mean)
+      .Set("median", s.median)
+      .Set("std", s.std)
+      .Set("min", s.min);
   j.Set("max", s.max).Set("count", s.count);
   return j;
 }
@@ -125,15 +129,16 @@ bool ParseVector3(const std::string& text, Eigen::Vector3d* v) {
 
 // ---------------------------------------------------------------- ate
 
-Status LoadGroundTruthCamera(const Args& args, const mbslam::ChannelOptions& channels, eval::Trajectory* gt,
-                             std::string* description) {
+Status LoadGroundTruthCamera(const Args& args, const mbslam::ChannelOptions& channels,
+                             eval::Trajectory* gt, std::string* description) {
   if (args.Has("gt")) {
     *description = args.Get("gt");
     return eval::ReadTumTrajectory(args.Get("gt"), gt);
   }
   if (args.Has("gt-log")) {
     eval::GroundTruthLog log;
-    MBSLAM_RETURN_IF_ERROR(eval::ReadGroundTruthLog(args.Get("gt-log"), args.Get("gt-channel", channels.ground_truth), &log));
+    MBSLAM_RETURN_IF_ERROR(eval::ReadGroundTruthLog(
+        args.Get("gt-log"), args.Get("gt-channel", channels.ground_truth), &log));
     *gt = log.camera;
     *description = args.Get("gt-log") + " (" + log.source + ")";
     return Status::Ok();
@@ -147,9 +152,11 @@ Status LoadGroundTruthCamera(const Args& args, const mbslam::ChannelOptions& cha
   }
   if (args.Has("gt-tartanair")) {
     *description = args.Get("gt-tartanair");
-    return eval::ReadTartanAirPoses(args.Get("gt-tartanair"), args.GetInt("frame-period-us", 1000000), gt);
+    return eval::ReadTartanAirPoses(args.Get("gt-tartanair"),
+                                    args.GetInt("frame-period-us", 1000000), gt);
   }
-  return Status::Error("ate: give --gt FILE.tum, --gt-log LOG, --gt-sequence DIR or --gt-tartanair pose_left.txt");
+  return Status::Error(
+      "ate: give --gt FILE.tum, --gt-log LOG, --gt-sequence DIR or --gt-tartanair pose_left.txt");
 }
 
 int RunAte(const Args& args) {
@@ -165,7 +172,8 @@ int RunAte(const Args& args) {
   } else if (args.Has("est-log")) {
     eval::CameraPoseLog log;
     est_description = args.Get("est-log");
-    st = eval::ReadCameraPoseLog(args.Get("est-log"), args.Get("est-channel", channels.perception_camera_pose), &log);
+    st = eval::ReadCameraPoseLog(args.Get("est-log"),
+                                 args.Get("est-channel", channels.perception_camera_pose), &log);
     est = log.tracked;
     est_messages = log.num_messages;
     est_metric = log.num_metric;
@@ -189,16 +197,21 @@ int RunAte(const Args& args) {
   const double tracked = eval::FractionTracked(est, gt, options.max_time_diff_us);
 
   std::printf("ATE of %s against %s\n", est_description.c_str(), gt_description.c_str());
-  std::printf("  poses: %d estimated, %d ground truth, %zu associated (max dt %lld us), fraction tracked %.3f\n",
-              ate.num_est, ate.num_gt, ate.pairs.size(), static_cast<long long>(options.max_time_diff_us), tracked);
+  std::printf(
+      "  poses: %d estimated, %d ground truth, %zu associated (max dt %lld us), fraction tracked "
+      "%.3f\n",
+      ate.num_est, ate.num_gt, ate.pairs.size(), static_cast<long long>(options.max_time_diff_us),
+      tracked);
   std::printf("  alignment %s: scale %.6f\n", options.alignment.c_str(), ate.gt_from_est.scale);
-  std::printf("  ATE translation: rmse %.6f m, mean %.6f, median %.6f, max %.6f\n", ate.translation.rmse,
-              ate.translation.mean, ate.translation.median, ate.translation.max);
+  std::printf("  ATE translation: rmse %.6f m, mean %.6f, median %.6f, max %.6f\n",
+              ate.translation.rmse, ate.translation.mean, ate.translation.median,
+              ate.translation.max);
   std::printf("  ATE rotation: rmse %.4f deg\n", ate.rotation_deg.rmse);
   if (rpe_status.ok()) {
     std::printf("  RPE (delta %s): translation rmse %.6f m, rotation rmse %.4f deg (%d pairs)\n",
-                rpe_options.delta_us > 0 ? (std::to_string(rpe_options.delta_us) + " us").c_str()
-                                         : (std::to_string(rpe_options.delta_frames) + " frames").c_str(),
+                rpe_options.delta_us > 0
+                    ? (std::to_string(rpe_options.delta_us) + " us").c_str()
+                    : (std::to_string(rpe_options.delta_frames) + " frames").c_str(),
                 rpe.translation.rmse, rpe.rotation_deg.rmse, rpe.translation.count);
   } else {
     std::printf("  RPE: %s\n", rpe_status.message().c_str());
@@ -206,7 +219,8 @@ int RunAte(const Args& args) {
   if (args.Has("plot")) {
     eval::TopViewPlot plot;
     char title[256];
-    std::snprintf(title, sizeof(title), "%s  ATE %.4f m (%s)", args.Get("title", fs::path(est_description).filename().string()).c_str(),
+    std::snprintf(title, sizeof(title), "%s  ATE %.4f m (%s)",
+                  args.Get("title", fs::path(est_description).filename().string()).c_str(),
                   ate.translation.rmse, options.alignment.c_str());
     plot.title = title;
     st = eval::WriteTopView(args.Get("plot"), gt, ate.est_aligned, plot);
@@ -234,7 +248,8 @@ int RunAte(const Args& args) {
 
 Status LoadTruthLabels(const std::string& path, std::vector<int>* labels) {
   const std::string suffix = ".tracks.txt";
-  if (path.size() > suffix.size() && path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0) {
+  if (path.size() > suffix.size() &&
+      path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0) {
     eval::TrackSet set;
     MBSLAM_RETURN_IF_ERROR(eval::ReadTracksFile(path, &set));
     *labels = set.labels;
@@ -257,20 +272,24 @@ int RunSeg(const Args& args) {
     if (st.ok()) st = LoadTruthLabels(args.Get("truth"), &truth);
     if (!st.ok()) return Fail(st.message());
     if (pred.size() != truth.size()) {
-      return Fail("seg: " + std::to_string(pred.size()) + " predicted labels for " + std::to_string(truth.size()) +
-                  " points");
+      return Fail("seg: " + std::to_string(pred.size()) + " predicted labels for " +
+                  std::to_string(truth.size()) + " points");
     }
     const auto r = eval::Misclassification(pred, truth);
-    std::printf("misclassification: %d of %d points wrong = %.4f (%d predicted groups, %d true groups)\n",
-                r.num_errors, r.num_points, r.rate, r.num_pred_groups, r.num_true_groups);
+    std::printf(
+        "misclassification: %d of %d points wrong = %.4f (%d predicted groups, %d true groups)\n",
+        r.num_errors, r.num_points, r.rate, r.num_pred_groups, r.num_true_groups);
     Json j = Json::Object();
     j.Set("metric", "misclassification").Set("rate", r.rate).Set("errors", r.num_errors);
-    j.Set("points", r.num_points).Set("pred_groups", r.num_pred_groups).Set("true_groups", r.num_true_groups);
+    j.Set("points", r.num_points)
+        .Set("pred_groups", r.num_pred_groups)
+        .Set("true_groups", r.num_true_groups);
     return Finish(j, args);
   }
   if (args.Has("pred-dir")) {
     const std::string tracks_dir = args.Get("tracks-dir", eval::DataSetPath("hopkins155"));
-    if (tracks_dir.empty()) return Fail("seg: no --tracks-dir and no hopkins155 under " + eval::DataRoot());
+    if (tracks_dir.empty())
+      return Fail("seg: no --tracks-dir and no hopkins155 under " + eval::DataRoot());
     const std::string suffix = args.Get("pred-suffix", ".labels.txt");
     std::vector<eval::TrackSet> sets;
     Status st = eval::ReadTracksFolder(tracks_dir, &sets);
@@ -303,13 +322,13 @@ int RunSeg(const Args& args) {
       return v.empty() ? 0.0 : s / static_cast<double>(v.size());
     };
     for (const auto& g : by_groups) {
-      std::printf("%d groups: %zu sequences, mean %.4f, median %.4f\n", g.first, g.second.size(), mean(g.second),
-                  Median(g.second));
+      std::printf("%d groups: %zu sequences, mean %.4f, median %.4f\n", g.first, g.second.size(),
+                  mean(g.second), Median(g.second));
       j.Set(std::to_string(g.first) + "_groups_mean", mean(g.second));
       j.Set(std::to_string(g.first) + "_groups_median", Median(g.second));
     }
-    std::printf("all: %zu sequences, mean %.4f, median %.4f (%d without predictions)\n", all.size(), mean(all),
-                Median(all), missing);
+    std::printf("all: %zu sequences, mean %.4f, median %.4f (%d without predictions)\n", all.size(),
+                mean(all), Median(all), missing);
     j.Set("all_mean", mean(all)).Set("all_median", Median(all)).Set("per_sequence", per);
     return Finish(j, args);
   }
@@ -319,7 +338,8 @@ int RunSeg(const Args& args) {
 // ---------------------------------------------------------------- masks
 
 // Features "frame_stem u v moving(0/1)" per line ('#' comments), grouped by frame.
-Status ReadFeatureFile(const std::string& path, std::map<std::string, std::vector<eval::LabelledFeature>>* features) {
+Status ReadFeatureFile(const std::string& path,
+                       std::map<std::string, std::vector<eval::LabelledFeature>>* features) {
   std::string text;
   MBSLAM_RETURN_IF_ERROR(mbslam::ReadFileToString(path, &text));
   std::istringstream in(text);
@@ -330,7 +350,8 @@ Status ReadFeatureFile(const std::string& path, std::map<std::string, std::vecto
     std::string stem;
     eval::LabelledFeature f;
     int moving = 0;
-    if (!(ls >> stem >> f.u >> f.v >> moving)) return Status::Error(path + ": bad feature line '" + line + "'");
+    if (!(ls >> stem >> f.u >> f.v >> moving))
+      return Status::Error(path + ": bad feature line '" + line + "'");
     f.moving = moving != 0;
     (*features)[stem].push_back(f);
   }
@@ -374,14 +395,15 @@ int RunMasks(const Args& args) {
   double sum = 0.0;
   for (double v : ious) sum += v;
   const double mean = sum / static_cast<double>(ious.size());
-  std::printf("region IoU over %zu frames: mean %.4f, median %.4f (%d frames without prediction)\n", ious.size(), mean,
-              Median(ious), missing);
+  std::printf("region IoU over %zu frames: mean %.4f, median %.4f (%d frames without prediction)\n",
+              ious.size(), mean, Median(ious), missing);
   Json j = Json::Object();
   j.Set("metric", "masks").Set("frames", ious.size()).Set("missing", missing).Set("iou_mean", mean);
   j.Set("iou_median", Median(ious));
   if (!features.empty()) {
-    std::printf("moving features: precision %.4f, recall %.4f (TP %d, FP %d, FN %d)\n", total.precision, total.recall,
-                total.true_positives, total.false_positives, total.false_negatives);
+    std::printf("moving features: precision %.4f, recall %.4f (TP %d, FP %d, FN %d)\n",
+                total.precision, total.recall, total.true_positives, total.false_positives,
+                total.false_negatives);
     j.Set("precision", total.precision).Set("recall", total.recall).Set("f1", total.f1);
   }
   return Finish(j, args);
@@ -391,8 +413,10 @@ int RunMasks(const Args& args) {
 
 int RunCamVid(const Args& args) {
   const std::string root = args.Get("root", eval::DataSetPath("camvid_0016E5_15hz"));
-  if (root.empty()) return Fail("camvid: no --root and no camvid_0016E5_15hz under " + eval::DataRoot());
-  if (!args.Has("features")) return Fail("camvid: give --features FILE (\"stem u v moving\" per line)");
+  if (root.empty())
+    return Fail("camvid: no --root and no camvid_0016E5_15hz under " + eval::DataRoot());
+  if (!args.Has("features"))
+    return Fail("camvid: give --features FILE (\"stem u v moving\" per line)");
   std::map<std::string, std::vector<eval::LabelledFeature>> features;
   Status st = ReadFeatureFile(args.Get("features"), &features);
   if (!st.ok()) return Fail(st.message());
@@ -409,9 +433,11 @@ int RunCamVid(const Args& args) {
     total.Add(eval::CamVidMovingFeatureStats(it->second, labels));
     ++used;
   }
-  std::printf("CamVid: %d labelled frames with features; %d moving features: %.4f on static classes, %.4f on "
-              "cars / pedestrians / bicyclists, %d on void\n",
-              used, total.moving, total.static_fraction, total.movable_fraction, total.on_void);
+  std::printf(
+      "CamVid: %d labelled frames with features; %d moving features: %.4f on static classes, %.4f "
+      "on "
+      "cars / pedestrians / bicyclists, %d on void\n",
+      used, total.moving, total.static_fraction, total.movable_fraction, total.on_void);
   Json j = Json::Object();
   j.Set("metric", "camvid").Set("frames", used).Set("moving_features", total.moving);
   j.Set("static_fraction", total.static_fraction).Set("movable_fraction", total.movable_fraction);
@@ -423,18 +449,22 @@ int RunCamVid(const Args& args) {
 
 int RunObjects(const Args& args) {
   const mbslam::ChannelOptions channels;
-  if (!args.Has("est-log") || !args.Has("gt-log")) return Fail("objects: give --est-log LOG --gt-log LOG");
+  if (!args.Has("est-log") || !args.Has("gt-log"))
+    return Fail("objects: give --est-log LOG --gt-log LOG");
   eval::GroundTruthLog gt;
-  Status st = eval::ReadGroundTruthLog(args.Get("gt-log"), args.Get("gt-channel", channels.ground_truth), &gt);
+  Status st = eval::ReadGroundTruthLog(args.Get("gt-log"),
+                                       args.Get("gt-channel", channels.ground_truth), &gt);
   if (!st.ok()) return Fail(st.message());
   std::map<int, eval::ObjectEstimate> objects;
   int messages = 0;
-  st = eval::ReadObjectsLog(args.Get("est-log"), args.Get("objects-channel", channels.perception_objects), &objects,
+  st = eval::ReadObjectsLog(args.Get("est-log"),
+                            args.Get("objects-channel", channels.perception_objects), &objects,
                             &messages);
   if (!st.ok()) return Fail(st.message());
   // The estimate's world frame, from the camera trajectories.
   eval::CameraPoseLog cam;
-  st = eval::ReadCameraPoseLog(args.Get("est-log"), args.Get("est-channel", channels.perception_camera_pose), &cam);
+  st = eval::ReadCameraPoseLog(args.Get("est-log"),
+                               args.Get("est-channel", channels.perception_camera_pose), &cam);
   if (!st.ok()) return Fail(st.message());
   eval::AteOptions ate_options;
   ate_options.alignment = args.Get("align", "sim3");
@@ -447,18 +477,27 @@ int RunObjects(const Args& args) {
   eval::ObjectsEvaluation result;
   st = eval::EvaluateObjects(objects, gt.bodies, gt.camera, ate.gt_from_est, options, &result);
   if (!st.ok()) return Fail(st.message());
-  std::printf("objects: %d estimated, %d true bodies, %zu matched, %d unmatched estimates (camera ATE %.4f m)\n",
-              result.num_est_objects, result.num_gt_bodies, result.objects.size(), result.unmatched_est,
-              ate.translation.rmse);
+  std::printf(
+      "objects: %d estimated, %d true bodies, %zu matched, %d unmatched estimates (camera ATE %.4f "
+      "m)\n",
+      result.num_est_objects, result.num_gt_bodies, result.objects.size(), result.unmatched_est,
+      ate.translation.rmse);
   Json list = Json::Array();
   for (const auto& o : result.objects) {
-    std::printf("  est %d -> body %d (%s): %d samples, error %.3f m, scale-aligned %.3f m, scale %.3f, depth error "
-                "%.3f m, volumes %d/%d inside\n",
-                o.est_id, o.gt_id, o.gt_name.c_str(), o.num_samples, o.position_error.rmse,
-                o.position_error_scaled.rmse, o.best_scale, o.depth_error.rmse, o.volumes_hit, o.volumes_checked);
+    std::printf(
+        "  est %d -> body %d (%s): %d samples, error %.3f m, scale-aligned %.3f m, scale %.3f, "
+        "depth error "
+        "%.3f m, volumes %d/%d inside\n",
+        o.est_id, o.gt_id, o.gt_name.c_str(), o.num_samples, o.position_error.rmse,
+        o.position_error_scaled.rmse, o.best_scale, o.depth_error.rmse, o.volumes_hit,
+        o.volumes_checked);
     Json oj = Json::Object();
-    oj.Set("est_id", o.est_id).Set("gt_id", o.gt_id).Set("name", o.gt_name).Set("samples", o.num_samples);
-    oj.Set("position_rmse_m", o.position_error.rmse).Set("position_scaled_rmse_m", o.position_error_scaled.rmse);
+    oj.Set("est_id", o.est_id)
+        .Set("gt_id", o.gt_id)
+        .Set("name", o.gt_name)
+        .Set("samples", o.num_samples);
+    oj.Set("position_rmse_m", o.position_error.rmse)
+        .Set("position_scaled_rmse_m", o.position_error_scaled.rmse);
     oj.Set("best_scale", o.best_scale).Set("relative_scale_error", o.relative_scale_error);
     oj.Set("depth_rmse_m", o.depth_error.rmse).Set("volume_hit_rate", o.hit_rate);
     Json series = Json::Array();
@@ -467,9 +506,12 @@ int RunObjects(const Args& args) {
     list.Push(oj);
   }
   std::printf("predicted volumes at %lld us: %d of %d contain the true centre (%.3f)\n",
-              static_cast<long long>(options.horizon_us), result.volumes_hit, result.volumes_checked, result.hit_rate);
+              static_cast<long long>(options.horizon_us), result.volumes_hit,
+              result.volumes_checked, result.hit_rate);
   Json j = Json::Object();
-  j.Set("metric", "objects").Set("est_objects", result.num_est_objects).Set("gt_bodies", result.num_gt_bodies);
+  j.Set("metric", "objects")
+      .Set("est_objects", result.num_est_objects)
+      .Set("gt_bodies", result.num_gt_bodies);
   j.Set("matched", result.objects.size()).Set("unmatched_est", result.unmatched_est);
   j.Set("volume_hit_rate", result.hit_rate).Set("volumes_checked", result.volumes_checked);
   j.Set("camera_ate_rmse_m", ate.translation.rmse).Set("objects", list);
@@ -479,7 +521,8 @@ int RunObjects(const Args& args) {
 // ---------------------------------------------------------------- points
 
 int RunPoints(const Args& args) {
-  if (!args.Has("est") || !args.Has("gt")) return Fail("points: give --est XYZ --gt XYZ (same frame and units)");
+  if (!args.Has("est") || !args.Has("gt"))
+    return Fail("points: give --est XYZ --gt XYZ (same frame and units)");
   std::vector<Eigen::Vector3d> est, gt;
   Status st = eval::ReadPointsFile(args.Get("est"), &est);
   if (st.ok()) st = eval::ReadPointsFile(args.Get("gt"), &gt);
@@ -487,10 +530,12 @@ int RunPoints(const Args& args) {
   const double threshold = args.GetDouble("threshold", 0.05);
   const double max_distance = args.GetDouble("max-distance", 1.0);
   const eval::ReconstructionError e = eval::CompareToSurface(est, gt, threshold, max_distance);
-  std::printf("reconstruction: %zu points against %zu true samples: accuracy median %.4f m, rmse %.4f m, %d beyond "
-              "%.2f m; completeness %.3f within %.3f m\n",
-              est.size(), gt.size(), e.accuracy.median, e.accuracy.rmse, e.outliers, max_distance, e.completeness,
-              threshold);
+  std::printf(
+      "reconstruction: %zu points against %zu true samples: accuracy median %.4f m, rmse %.4f m, "
+      "%d beyond "
+      "%.2f m; completeness %.3f within %.3f m\n",
+      est.size(), gt.size(), e.accuracy.median, e.accuracy.rmse, e.outliers, max_distance,
+      e.completeness, threshold);
   Json j = Json::Object();
   j.Set("metric", "points").Set("points", est.size()).Set("truth_points", gt.size());
   j.Set("accuracy_median_m", e.accuracy.median).Set("accuracy_rmse_m", e.accuracy.rmse);
@@ -508,21 +553,25 @@ int RunPerturb(const Args& args) {
   eval::TrajectoryPerturbation p;
   p.gt_from_est.scale = args.GetDouble("scale", 1.0);
   Eigen::Vector3d axis(0.0, 0.0, 1.0), trans = Eigen::Vector3d::Zero();
-  if (args.Has("axis") && !ParseVector3(args.Get("axis"), &axis)) return Fail("perturb: --axis wants x,y,z");
-  if (args.Has("trans") && !ParseVector3(args.Get("trans"), &trans)) return Fail("perturb: --trans wants x,y,z");
+  if (args.Has("axis") && !ParseVector3(args.Get("axis"), &axis))
+    return Fail("perturb: --axis wants x,y,z");
+  if (args.Has("trans") && !ParseVector3(args.Get("trans"), &trans))
+    return Fail("perturb: --trans wants x,y,z");
   if (axis.norm() == 0.0 || !(p.gt_from_est.scale > 0.0)) return Fail("perturb: bad axis or scale");
-  p.gt_from_est.rotation =
-      Eigen::Quaterniond(Eigen::AngleAxisd(args.GetDouble("rot-deg", 0.0) * M_PI / 180.0, axis.normalized()));
+  p.gt_from_est.rotation = Eigen::Quaterniond(
+      Eigen::AngleAxisd(args.GetDouble("rot-deg", 0.0) * M_PI / 180.0, axis.normalized()));
   p.gt_from_est.translation = trans;
   p.noise_sigma_m = args.GetDouble("noise", 0.0);
   p.seed = static_cast<uint64_t>(args.GetInt("seed", 1));
   p.exact = !args.Has("no-exact");
   double expected = 0.0;
   st = eval::PerturbTrajectory(gt, p, &est, &expected);
-  if (st.ok()) st = eval::WriteTumTrajectory(args.Get("out"), est, "perturbed copy of " + args.Get("in"));
+  if (st.ok())
+    st = eval::WriteTumTrajectory(args.Get("out"), est, "perturbed copy of " + args.Get("in"));
   if (!st.ok()) return Fail(st.message());
-  std::printf("wrote %zu poses to %s: est = S^-1 (gt + n), scale %.6f, noise rms %.6f m%s\n", est.size(),
-              args.Get("out").c_str(), p.gt_from_est.scale, expected, p.exact ? " (exact)" : "");
+  std::printf("wrote %zu poses to %s: est = S^-1 (gt + n), scale %.6f, noise rms %.6f m%s\n",
+              est.size(), args.Get("out").c_str(), p.gt_from_est.scale, expected,
+              p.exact ? " (exact)" : "");
   Json j = Json::Object();
   j.Set("metric", "perturb").Set("poses", est.size()).Set("scale", p.gt_from_est.scale);
   j.Set("expected_ate_sim3_m", expected).Set("exact", p.exact);
@@ -530,7 +579,8 @@ int RunPerturb(const Args& args) {
 }
 
 int RunPerturbLabels(const Args& args) {
-  if (!args.Has("truth") || !args.Has("out")) return Fail("perturb-labels: give --truth FILE --out FILE");
+  if (!args.Has("truth") || !args.Has("out"))
+    return Fail("perturb-labels: give --truth FILE --out FILE");
   std::vector<int> truth, pred;
   Status st = LoadTruthLabels(args.Get("truth"), &truth);
   if (!st.ok()) return Fail(st.message());
@@ -544,9 +594,10 @@ int RunPerturbLabels(const Args& args) {
   st = eval::PerturbLabels(truth, p, &pred, &expected);
   if (st.ok()) st = eval::WriteLabelFile(args.Get("out"), pred);
   if (!st.ok()) return Fail(st.message());
-  const double rate = truth.empty() ? 0.0 : static_cast<double>(expected) / static_cast<double>(truth.size());
-  std::printf("wrote %zu labels to %s with %d known errors (rate %.6f)\n", pred.size(), args.Get("out").c_str(),
-              expected, rate);
+  const double rate =
+      truth.empty() ? 0.0 : static_cast<double>(expected) / static_cast<double>(truth.size());
+  std::printf("wrote %zu labels to %s with %d known errors (rate %.6f)\n", pred.size(),
+              args.Get("out").c_str(), expected, rate);
   Json j = Json::Object();
   j.Set("metric", "perturb-labels").Set("points", truth.size()).Set("expected_errors", expected);
   j.Set("expected_rate", rate);
@@ -574,7 +625,8 @@ int RunDatasets(const Args& args) {
     info.Set("sequences", sets.size());
     bool first = true;
     for (const auto& g : by_groups) {
-      text += (first ? "" : ", ") + std::to_string(g.second) + " with " + std::to_string(g.first) + " groups";
+      text += (first ? "" : ", ") + std::to_string(g.second) + " with " + std::to_string(g.first) +
+              " groups";
       first = false;
       info.Set(std::to_string(g.first) + "_groups", g.second);
     }
@@ -586,7 +638,8 @@ int RunDatasets(const Args& args) {
     if (!st.ok()) return Fail(st.message());
     size_t frames = 0;
     for (const auto& s : seqs) frames += s.masks.size();
-    report("davis2016", std::to_string(seqs.size()) + " sequences, " + std::to_string(frames) + " masked frames",
+    report("davis2016",
+           std::to_string(seqs.size()) + " sequences, " + std::to_string(frames) + " masked frames",
            Json::Object().Set("sequences", seqs.size()).Set("frames", frames));
   }
   if (const std::string p = eval::DataSetPath("camvid_0016E5_15hz"); !p.empty()) {
@@ -612,7 +665,8 @@ int RunDatasets(const Args& args) {
       length += (ta.truth[i].pose.translation - ta.truth[i - 1].pose.translation).norm();
     }
     report("tartanair_indoor_subset",
-           std::to_string(ta.truth.size()) + " poses and images, path " + std::to_string(length) + " m",
+           std::to_string(ta.truth.size()) + " poses and images, path " + std::to_string(length) +
+               " m",
            Json::Object().Set("frames", ta.truth.size()).Set("path_length_m", length));
   }
   return Finish(j, args);

@@ -37,7 +37,8 @@ TEST(Hungarian, MatchesBruteForceOnRandomRectangularProblems) {
     const int r = size(rng), c = size(rng);
     Eigen::MatrixXd cost(r, c);
     for (int i = 0; i < r; ++i) {
-      for (int j = 0; j < c; ++j) cost(i, j) = (trial % 3 == 0) ? std::round(value(rng)) : value(rng);
+      for (int j = 0; j < c; ++j)
+        cost(i, j) = (trial % 3 == 0) ? std::round(value(rng)) : value(rng);
     }
     double total = 0.0;
     const auto assignment = SolveAssignment(cost, &total);
@@ -51,7 +52,8 @@ TEST(Hungarian, MatchesBruteForceOnRandomRectangularProblems) {
     EXPECT_EQ(static_cast<int>(used.size()), std::min(r, c));
     double check = 0.0;
     for (int i = 0; i < r; ++i) {
-      if (assignment[static_cast<size_t>(i)] >= 0) check += cost(i, assignment[static_cast<size_t>(i)]);
+      if (assignment[static_cast<size_t>(i)] >= 0)
+        check += cost(i, assignment[static_cast<size_t>(i)]);
     }
     EXPECT_NEAR(check, total, 1e-9);
     EXPECT_NEAR(total, BruteForce(cost), 1e-9) << "trial " << trial << "\n" << cost;

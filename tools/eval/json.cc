@@ -52,11 +52,21 @@ void AppendEscaped(const std::string& s, std::string* out) {
   out->push_back('"');
   for (char c : s) {
     switch (c) {
-      case '"': *out += "\\\""; break;
-      case '\\': *out += "\\\\"; break;
-      case '\n': *out += "\\n"; break;
-      case '\t': *out += "\\t"; break;
-      case '\r': *out += "\\r"; break;
+      case '"':
+        *out += "\\\"";
+        break;
+      case '\\':
+        *out += "\\\\";
+        break;
+      case '\n':
+        *out += "\\n";
+        break;
+      case '\t':
+        *out += "\\t";
+        break;
+      case '\r':
+        *out += "\\r";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
@@ -74,9 +84,15 @@ void AppendEscaped(const std::string& s, std::string* out) {
 
 void Json::DumpTo(std::string* out) const {
   switch (type_) {
-    case Type::kNull: *out += "null"; break;
-    case Type::kBool: *out += bool_ ? "true" : "false"; break;
-    case Type::kInt: *out += std::to_string(int_); break;
+    case Type::kNull:
+      *out += "null";
+      break;
+    case Type::kBool:
+      *out += bool_ ? "true" : "false";
+      break;
+    case Type::kInt:
+      *out += std::to_string(int_);
+      break;
     case Type::kDouble: {
       if (!std::isfinite(double_)) {
         *out += "null";
@@ -89,7 +105,9 @@ void Json::DumpTo(std::string* out) const {
       }
       break;
     }
-    case Type::kString: AppendEscaped(string_, out); break;
+    case Type::kString:
+      AppendEscaped(string_, out);
+      break;
     case Type::kArray:
       out->push_back('[');
       for (size_t i = 0; i < array_.size(); ++i) {
@@ -148,18 +166,29 @@ class Parser {
         if (pos_ >= s_.size()) return false;
         const char e = s_[pos_++];
         switch (e) {
-          case 'n': c = '\n'; break;
-          case 't': c = '\t'; break;
-          case 'r': c = '\r'; break;
-          case 'b': c = '\b'; break;
-          case 'f': c = '\f'; break;
+          case 'n':
+            c = '\n';
+            break;
+          case 't':
+            c = '\t';
+            break;
+          case 'r':
+            c = '\r';
+            break;
+          case 'b':
+            c = '\b';
+            break;
+          case 'f':
+            c = '\f';
+            break;
           case 'u': {
             if (pos_ + 4 > s_.size()) return false;
             c = static_cast<char>(std::strtol(s_.substr(pos_, 4).c_str(), nullptr, 16));
             pos_ += 4;
             break;
           }
-          default: c = e;
+          default:
+            c = e;
         }
       }
       out->push_back(c);
@@ -188,7 +217,10 @@ class Parser {
         if (!ParseValue(&value)) return false;
         out->Set(key, std::move(value));
         SkipSpace();
-        if (pos_ < s_.size() && s_[pos_] == ',') { ++pos_; continue; }
+        if (pos_ < s_.size() && s_[pos_] == ',') {
+          ++pos_;
+          continue;
+        }
         if (pos_ < s_.size() && s_[pos_] == '}') return ++pos_, true;
         return false;
       }
@@ -203,7 +235,10 @@ class Parser {
         if (!ParseValue(&value)) return false;
         out->Push(std::move(value));
         SkipSpace();
-        if (pos_ < s_.size() && s_[pos_] == ',') { ++pos_; continue; }
+        if (pos_ < s_.size() && s_[pos_] == ',') {
+          ++pos_;
+          continue;
+        }
         if (pos_ < s_.size() && s_[pos_] == ']') return ++pos_, true;
         return false;
       }

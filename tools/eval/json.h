@@ -23,18 +23,26 @@ class Json {
  public:
   enum class Type { kNull, kBool, kInt, kDouble, kString, kArray, kObject };
 
-  Json() = default;  // null
-  Json(bool v) : type_(Type::kBool), bool_(v) {}                      // NOLINT(runtime/explicit)
-  Json(int v) : type_(Type::kInt), int_(v) {}                         // NOLINT(runtime/explicit)
-  Json(int64_t v) : type_(Type::kInt), int_(v) {}                     // NOLINT(runtime/explicit)
+  Json() = default;                                                     // null
+  Json(bool v) : type_(Type::kBool), bool_(v) {}                        // NOLINT(runtime/explicit)
+  Json(int v) : type_(Type::kInt), int_(v) {}                           // NOLINT(runtime/explicit)
+  Json(int64_t v) : type_(Type::kInt), int_(v) {}                       // NOLINT(runtime/explicit)
   Json(size_t v) : type_(Type::kInt), int_(static_cast<int64_t>(v)) {}  // NOLINT(runtime/explicit)
-  Json(double v) : type_(Type::kDouble), double_(v) {}                // NOLINT(runtime/explicit)
-  Json(const char* v) : type_(Type::kString), string_(v) {}           // NOLINT(runtime/explicit)
+  Json(double v) : type_(Type::kDouble), double_(v) {}                  // NOLINT(runtime/explicit)
+  Json(const char* v) : type_(Type::kString), string_(v) {}             // NOLINT(runtime/explicit)
   Json(std::string v) : type_(Type::kString), string_(std::move(v)) {}  // NOLINT(runtime/explicit)
-  Json(const std::vector<double>& values);                            // NOLINT(runtime/explicit)
+  Json(const std::vector<double>& values);                              // NOLINT(runtime/explicit)
 
-  static Json Object() { Json j; j.type_ = Type::kObject; return j; }
-  static Json Array() { Json j; j.type_ = Type::kArray; return j; }
+  static Json Object() {
+    Json j;
+    j.type_ = Type::kObject;
+    return j;
+  }
+  static Json Array() {
+    Json j;
+    j.type_ = Type::kArray;
+    return j;
+  }
 
   Type type() const { return type_; }
   // Object: sets (or replaces) a key. Turns a null value into an object.

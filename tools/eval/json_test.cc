@@ -14,18 +14,23 @@ TEST(Json, DumpsInInsertionOrder) {
   j.Set("b", 1).Set("a", 2.5).Set("s", "x\"y\n").Set("t", true).Set("n", Json());
   j.Set("arr", Json(std::vector<double>{1.0, 0.5}));
   j.Set("b", int64_t{7});  // replaces, keeps position
-  EXPECT_EQ(j.Dump(), R"({"b": 7, "a": 2.5, "s": "x\"y\n", "t": true, "n": null, "arr": [1, 0.5]})");
+  EXPECT_EQ(j.Dump(),
+            R"({"b": 7, "a": 2.5, "s": "x\"y\n", "t": true, "n": null, "arr": [1, 0.5]})");
 }
 
 TEST(Json, NonFiniteIsNull) {
   Json j = Json::Object();
-  j.Set("nan", std::numeric_limits<double>::quiet_NaN()).Set("inf", std::numeric_limits<double>::infinity());
+  j.Set("nan", std::numeric_limits<double>::quiet_NaN())
+      .Set("inf", std::numeric_limits<double>::infinity());
   EXPECT_EQ(j.Dump(), R"({"nan": null, "inf": null})");
 }
 
 TEST(Json, ParseRoundTrip) {
   Json j = Json::Object();
-  j.Set("x", 0.125).Set("k", int64_t{-3}).Set("name", "sim:multi").Set("nested", Json::Object().Set("y", 1));
+  j.Set("x", 0.125)
+      .Set("k", int64_t{-3})
+      .Set("name", "sim:multi")
+      .Set("nested", Json::Object().Set("y", 1));
   j.Set("list", Json::Array().Push(1).Push("two").Push(Json::Array()));
   Json back;
   std::string error;

@@ -47,7 +47,8 @@ Status ReadCameraPoseLog(const std::string& path, const std::string& channel, Ca
   return Status::Ok();
 }
 
-Status ReadGroundTruthLog(const std::string& path, const std::string& channel, GroundTruthLog* log) {
+Status ReadGroundTruthLog(const std::string& path, const std::string& channel,
+                          GroundTruthLog* log) {
   *log = GroundTruthLog();
   Status status;
   auto reader = LcmLogReader::Open(path, &status);
@@ -59,7 +60,8 @@ Status ReadGroundTruthLog(const std::string& path, const std::string& channel, G
     if (!Decode(e, &msg)) return Status::Error(path + ": undecodable ground_truth_t on " + channel);
     ++log->num_messages;
     log->source = msg.source;
-    if (msg.has_camera) log->camera.push_back({msg.utime, MessagePose(msg.cam_position, msg.cam_orientation)});
+    if (msg.has_camera)
+      log->camera.push_back({msg.utime, MessagePose(msg.cam_position, msg.cam_orientation)});
     for (const auto& b : msg.bodies) {
       BodyTruth& body = log->bodies[b.id];
       body.id = b.id;
@@ -70,12 +72,13 @@ Status ReadGroundTruthLog(const std::string& path, const std::string& channel, G
   }
   SortByTime(&log->camera);
   for (auto& b : log->bodies) SortByTime(&b.second.poses);
-  if (log->num_messages == 0) return Status::Error(path + ": no ground_truth_t on channel " + channel);
+  if (log->num_messages == 0)
+    return Status::Error(path + ": no ground_truth_t on channel " + channel);
   return Status::Ok();
 }
 
-Status ReadObjectsLog(const std::string& path, const std::string& channel, std::map<int, ObjectEstimate>* objects,
-                      int* num_messages) {
+Status ReadObjectsLog(const std::string& path, const std::string& channel,
+                      std::map<int, ObjectEstimate>* objects, int* num_messages) {
   objects->clear();
   if (num_messages) *num_messages = 0;
   Status status;
@@ -99,7 +102,8 @@ Status ReadObjectsLog(const std::string& path, const std::string& channel, std::
         pv.utime = v.utime;
         pv.horizon_us = v.horizon_us;
         pv.center = Eigen::Vector3d(v.center[0], v.center[1], v.center[2]);
-        pv.orientation = Eigen::Quaterniond(v.orientation[0], v.orientation[1], v.orientation[2], v.orientation[3]);
+        pv.orientation = Eigen::Quaterniond(v.orientation[0], v.orientation[1], v.orientation[2],
+                                            v.orientation[3]);
         pv.orientation.normalize();
         pv.half_extent = Eigen::Vector3d(v.half_extent[0], v.half_extent[1], v.half_extent[2]);
         pv.probability = v.probability;

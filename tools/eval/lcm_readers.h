@@ -15,9 +15,9 @@ namespace mbslam {
 namespace eval {
 
 struct CameraPoseLog {
-  Trajectory tracked;     // poses with tracking_state TRACKING_OK or TRACKING_RELOCALIZED
-  int num_messages = 0;   // camera_pose_t messages (count)
-  int num_metric = 0;     // of them with scale_state SCALE_METRIC (count)
+  Trajectory tracked;    // poses with tracking_state TRACKING_OK or TRACKING_RELOCALIZED
+  int num_messages = 0;  // camera_pose_t messages (count)
+  int num_metric = 0;    // of them with scale_state SCALE_METRIC (count)
   int num_undecodable = 0;
 };
 Status ReadCameraPoseLog(const std::string& path, const std::string& channel, CameraPoseLog* log);
@@ -31,8 +31,8 @@ struct GroundTruthLog {
 Status ReadGroundTruthLog(const std::string& path, const std::string& channel, GroundTruthLog* log);
 
 // Objects by id, one sample per objects_t message in which they appear.
-Status ReadObjectsLog(const std::string& path, const std::string& channel, std::map<int, ObjectEstimate>* objects,
-                      int* num_messages = nullptr);
+Status ReadObjectsLog(const std::string& path, const std::string& channel,
+                      std::map<int, ObjectEstimate>* objects, int* num_messages = nullptr);
 
 // Number of events on a channel (e.g. images).
 Status CountLogEvents(const std::string& path, const std::string& channel, int* count);

@@ -25,7 +25,8 @@ void SetPose(const Rigid3d& p, double position[3], double orientation[4]) {
 
 TEST(LcmReaders, CameraPosesGroundTruthAndObjects) {
   const std::string path = (std::filesystem::temp_directory_path() /
-                            ("mbslam_eval_log_" + std::to_string(::getpid()) + ".lcmlog")).string();
+                            ("mbslam_eval_log_" + std::to_string(::getpid()) + ".lcmlog"))
+                               .string();
   {
     Status st;
     auto log = LcmLogWriter::Open(path, &st);
@@ -46,7 +47,8 @@ TEST(LcmReaders, CameraPosesGroundTruthAndObjects) {
       b.extent[0] = 0.4;
       b.extent[1] = 0.5;
       b.extent[2] = 1.75;
-      SetPose(Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(5.0, 0.1 * i, 0.875)), b.position, b.orientation);
+      SetPose(Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(5.0, 0.1 * i, 0.875)),
+              b.position, b.orientation);
       gt.bodies.push_back(b);
       gt.num_bodies = 1;
       ASSERT_TRUE(log->Write("GROUND_TRUTH", t, gt).ok());
@@ -56,10 +58,11 @@ TEST(LcmReaders, CameraPosesGroundTruthAndObjects) {
       pose.frame_seq = i;
       // Monocular map units: half scale. Not tracked for the first 4 frames, lost at 10.
       SetPose(Rigid3d(cam.rotation, 0.5 * cam.translation), pose.position, pose.orientation);
-      pose.tracking_state = i < 4 ? mbslam::camera_pose_t::TRACKING_INITIALIZING
-                                  : (i == 10 ? mbslam::camera_pose_t::TRACKING_LOST
-                                             : (i == 11 ? mbslam::camera_pose_t::TRACKING_RELOCALIZED
-                                                        : mbslam::camera_pose_t::TRACKING_OK));
+      pose.tracking_state = i < 4
+                                ? mbslam::camera_pose_t::TRACKING_INITIALIZING
+                                : (i == 10 ? mbslam::camera_pose_t::TRACKING_LOST
+                                           : (i == 11 ? mbslam::camera_pose_t::TRACKING_RELOCALIZED
+                                                      : mbslam::camera_pose_t::TRACKING_OK));
       pose.scale_state = mbslam::camera_pose_t::SCALE_UP_TO_SCALE;
       ASSERT_TRUE(log->Write("PERCEPTION_CAMERA_POSE", pose.utime, pose).ok());
 

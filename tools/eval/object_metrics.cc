@@ -26,8 +26,9 @@ bool InterpolatePose(const Trajectory& poses, int64_t utime, int64_t max_gap_us,
   const TimedPose& b = *it;
   const TimedPose& a = *std::prev(it);
   if (b.utime - a.utime > max_gap_us) return false;
-  *pose = Rigid3d::Interpolate(a.pose, b.pose,
-                               static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime));
+  *pose = Rigid3d::Interpolate(
+      a.pose, b.pose,
+      static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime));
   return true;
 }
 
@@ -56,16 +57,18 @@ struct Common {
   Eigen::Vector3d truth;   // body centre
   Eigen::Vector3d camera;  // camera centre
   Rigid3d cam_from_world;
-  double est_depth;        // < 0 if not given (truth units)
+  double est_depth;  // < 0 if not given (truth units)
   const ObjectSample* sample;
 };
 
-std::vector<Common> CommonSamples(const ObjectEstimate& est, const BodyTruth& body, const Trajectory& gt_camera,
-                                  const Sim3d& gt_from_est, int64_t tolerance) {
+std::vector<Common> CommonSamples(const ObjectEstimate& est, const BodyTruth& body,
+                                  const Trajectory& gt_camera, const Sim3d& gt_from_est,
+                                  int64_t tolerance) {
   std::vector<Common> out;
   for (const auto& s : est.samples) {
     Rigid3d body_pose, cam_pose;
-    if (!TruthAt(body.poses, s.utime, tolerance, &body_pose) || !TruthAt(gt_camera, s.utime, tolerance, &cam_pose)) {
+    if (!TruthAt(body.poses, s.utime, tolerance, &body_pose) ||
+        !TruthAt(gt_camera, s.utime, tolerance, &cam_pose)) {
       continue;
     }
     Common c;
@@ -83,8 +86,9 @@ std::vector<Common> CommonSamples(const ObjectEstimate& est, const BodyTruth& bo
 
 }  // namespace
 
-Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates, const std::map<int, BodyTruth>& truth,
-                       const Trajectory& gt_camera, const Sim3d& gt_from_est, const ObjectMetricsOptions& options,
+Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
+                       const std::map<int, BodyTruth>& truth, const Trajectory& gt_camera,
+                       const Sim3d& gt_from_est, const ObjectMetricsOptions& options,
                        ObjectsEvaluation* result) {
   if (!options.Check()) return Status::Error("object metrics options: " + LastOptionError());
   *result = ObjectsEvaluation();
@@ -96,11 +100,13 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates, const std
   for (const auto& t : truth) gt_list.push_back(&t.second);
   // Association: mean distance over common samples, gated, Hungarian.
   const double kForbidden = 1e9;
-  Eigen::MatrixXd cost = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(est_list.size()),
-                                                   static_cast<Eigen::Index>(gt_list.size()), kForbidden);
+  Eigen::MatrixXd cost =
+      Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(est_list.size()),
+                                static_cast<Eigen::Index>(gt_list.size()), kForbidden);
   for (size_t i = 0; i < est_list.size(); ++i) {
     for (size_t j = 0; j < gt_list.size(); ++j) {
-      const auto common = CommonSamples(*est_list[i], *gt_list[j], gt_camera, gt_from_est, options.max_time_diff_us);
+      const auto common = CommonSamples(*est_list[i], *gt_list[j], gt_camera, gt_from_est,
+                                        options.max_time_diff_us);
       if (static_cast<int>(common.size()) < options.min_samples) continue;
       double sum = 0.0;
       for (const auto& c : common) sum += (c.est - c.truth).norm();
@@ -151,18 +157,21 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates, const std
       for (const auto& v : s.volumes) {
         if (std::llabs(v.horizon_us - options.horizon_us) > options.horizon_tolerance_us) continue;
         Rigid3d body_pose;
-        if (!InterpolatePose(body.poses, v.utime, 1000000, &body_pose)) continue;  // beyond the truth
+        if (!InterpolatePose(body.poses, v.utime, 1000000, &body_pose))
+          continue;  // beyond the truth
         ++r.volumes_checked;
         if (v.Contains(est_from_gt * body_pose.translation)) ++r.volumes_hit;
       }
     }
-    r.hit_rate = r.volumes_checked > 0 ? static_cast<double>(r.volumes_hit) / r.volumes_checked : 0.0;
+    r.hit_rate =
+        r.volumes_checked > 0 ? static_cast<double>(r.volumes_hit) / r.volumes_checked : 0.0;
     result->volumes_checked += r.volumes_checked;
     result->volumes_hit += r.volumes_hit;
     result->objects.push_back(r);
   }
-  result->hit_rate =
-      result->volumes_checked > 0 ? static_cast<double>(result->volumes_hit) / result->volumes_checked : 0.0;
+  result->hit_rate = result->volumes_checked > 0
+                         ? static_cast<double>(result->volumes_hit) / result->volumes_checked
+                         : 0.0;
   return Status::Ok();
 }
 

@@ -28,11 +28,11 @@ namespace mbslam {
 namespace eval {
 
 struct PredictedVolume {
-  int64_t utime = 0;       // time the prediction is for (µs)
-  int64_t horizon_us = 0;  // utime minus the time of the estimate (µs)
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();          // world (estimate units)
+  int64_t utime = 0;                                 // time the prediction is for (µs)
+  int64_t horizon_us = 0;                            // utime minus the time of the estimate (µs)
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // world (estimate units)
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // world_from_box
-  Eigen::Vector3d half_extent = Eigen::Vector3d::Zero();     // (estimate units)
+  Eigen::Vector3d half_extent = Eigen::Vector3d::Zero();            // (estimate units)
   double probability = 0.0;
 
   // True if `point` (estimate world frame) is inside the box.
@@ -42,7 +42,7 @@ struct PredictedVolume {
 struct ObjectSample {
   int64_t utime = 0;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // world (estimate units)
-  double depth = -1.0;             // along the optical axis (estimate units); < 0 = not given
+  double depth = -1.0;  // along the optical axis (estimate units); < 0 = not given
   std::vector<PredictedVolume> volumes;
 };
 
@@ -59,11 +59,12 @@ struct BodyTruth {
 };
 
 struct ObjectMetricsOptions {
-  int64_t max_time_diff_us = 20000;       // estimate / truth association in time (µs)
-  double max_match_distance = 5.0;        // largest mean distance of an estimate from its body (m, truth units)
-  int min_samples = 3;                    // fewest common samples for a match (count)
-  int64_t horizon_us = 1000000;           // predicted-volume horizon evaluated (µs)
-  int64_t horizon_tolerance_us = 50000;   // volumes within this of the horizon count (µs)
+  int64_t max_time_diff_us = 20000;  // estimate / truth association in time (µs)
+  double max_match_distance =
+      5.0;              // largest mean distance of an estimate from its body (m, truth units)
+  int min_samples = 3;  // fewest common samples for a match (count)
+  int64_t horizon_us = 1000000;          // predicted-volume horizon evaluated (µs)
+  int64_t horizon_tolerance_us = 50000;  // volumes within this of the horizon count (µs)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(max_time_diff_us, 0);
@@ -76,10 +77,12 @@ struct ObjectMetricsOptions {
   template <typename V>
   void VisitFields(V& v) {
     v("max_time_diff_us", &max_time_diff_us, "estimate / truth association in time (µs)");
-    v("max_match_distance", &max_match_distance, "largest mean distance of an estimate from its body (m)");
+    v("max_match_distance", &max_match_distance,
+      "largest mean distance of an estimate from its body (m)");
     v("min_samples", &min_samples, "fewest common samples for a match (count)");
     v("horizon_us", &horizon_us, "predicted-volume horizon evaluated (µs)");
-    v("horizon_tolerance_us", &horizon_tolerance_us, "volumes within this of the horizon count (µs)");
+    v("horizon_tolerance_us", &horizon_tolerance_us,
+      "volumes within this of the horizon count (µs)");
   }
 };
 
@@ -88,14 +91,14 @@ struct ObjectResult {
   int gt_id = 0;
   std::string gt_name;
   int num_samples = 0;
-  ErrorStats position_error;         // without scale alignment (m)
-  ErrorStats position_error_scaled;  // with the best scale about the camera (m)
-  double best_scale = 1.0;           // s of p(s) = c + s (p - c)
-  double relative_scale_error = 0.0; // |best_scale - 1|
-  ErrorStats depth_error;            // |depth - true depth| (m)
+  ErrorStats position_error;          // without scale alignment (m)
+  ErrorStats position_error_scaled;   // with the best scale about the camera (m)
+  double best_scale = 1.0;            // s of p(s) = c + s (p - c)
+  double relative_scale_error = 0.0;  // |best_scale - 1|
+  ErrorStats depth_error;             // |depth - true depth| (m)
   std::vector<std::pair<int64_t, double>> depth_error_over_time;  // (utime, signed error m)
   int volumes_checked = 0;
-  int volumes_hit = 0;               // true centre inside the predicted box
+  int volumes_hit = 0;  // true centre inside the predicted box
   double hit_rate = 0.0;
 };
 
@@ -106,15 +109,16 @@ struct ObjectsEvaluation {
   int unmatched_est = 0;
   int volumes_checked = 0;
   int volumes_hit = 0;
-  double hit_rate = 0.0;              // over all matched objects
+  double hit_rate = 0.0;  // over all matched objects
 };
 
 // World pose of a body at `utime` by interpolation (false if outside its samples or the
 // gap is larger than max_gap_us).
 bool InterpolatePose(const Trajectory& poses, int64_t utime, int64_t max_gap_us, Rigid3d* pose);
 
-Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates, const std::map<int, BodyTruth>& truth,
-                       const Trajectory& gt_camera, const Sim3d& gt_from_est, const ObjectMetricsOptions& options,
+Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
+                       const std::map<int, BodyTruth>& truth, const Trajectory& gt_camera,
+                       const Sim3d& gt_from_est, const ObjectMetricsOptions& options,
                        ObjectsEvaluation* result);
 
 }  // namespace eval

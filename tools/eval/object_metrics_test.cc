@@ -29,8 +29,10 @@ Scene MakeScene() {
     const int64_t t = 1000000 + i * 33333;
     const double ts = i / 30.0;
     s.camera.push_back({t, Rigid3d(world_from_cam_rot, Eigen::Vector3d(ts, 0.0, 1.5))});
-    car.poses.push_back({t, Rigid3d(Eigen::Matrix3d::Identity(), Eigen::Vector3d(15.0, 8.0 - 5.0 * ts, 0.75))});
-    person.poses.push_back({t, Rigid3d(Eigen::Matrix3d::Identity(), Eigen::Vector3d(8.0, -3.0 + 1.0 * ts, 0.9))});
+    car.poses.push_back(
+        {t, Rigid3d(Eigen::Matrix3d::Identity(), Eigen::Vector3d(15.0, 8.0 - 5.0 * ts, 0.75))});
+    person.poses.push_back(
+        {t, Rigid3d(Eigen::Matrix3d::Identity(), Eigen::Vector3d(8.0, -3.0 + 1.0 * ts, 0.9))});
   }
   s.bodies[1] = car;
   s.bodies[2] = person;
@@ -111,7 +113,8 @@ TEST(ObjectMetrics, PredictedVolumeHitRate) {
     v.utime = s.utime + v.horizon_us;
     Rigid3d future;
     ASSERT_TRUE(InterpolatePose(car.poses, v.utime, 100000, &future));
-    v.center = future.translation + (i % 2 ? Eigen::Vector3d(0.0, 3.0, 0.0) : Eigen::Vector3d::Zero());
+    v.center =
+        future.translation + (i % 2 ? Eigen::Vector3d(0.0, 3.0, 0.0) : Eigen::Vector3d::Zero());
     v.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
     v.half_extent = Eigen::Vector3d::Ones();
     s.volumes.push_back(v);
@@ -121,7 +124,8 @@ TEST(ObjectMetrics, PredictedVolumeHitRate) {
     est[3].samples.push_back(s);
   }
   ObjectsEvaluation r;
-  ASSERT_TRUE(EvaluateObjects(est, scene.bodies, scene.camera, Sim3d(), ObjectMetricsOptions(), &r).ok());
+  ASSERT_TRUE(
+      EvaluateObjects(est, scene.bodies, scene.camera, Sim3d(), ObjectMetricsOptions(), &r).ok());
   ASSERT_EQ(r.objects.size(), 1u);
   EXPECT_EQ(r.objects[0].volumes_checked, 30);
   EXPECT_EQ(r.objects[0].volumes_hit, 15);
@@ -134,7 +138,7 @@ TEST(PredictedVolume, OrientedContainment) {
   v.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitZ()));
   v.half_extent = Eigen::Vector3d(2.0, 0.5, 1.0);
   EXPECT_TRUE(v.Contains(Eigen::Vector3d(1, 1, 0)));
-  EXPECT_TRUE(v.Contains(Eigen::Vector3d(2.2, 2.2, 0.5)));   // along the box's long axis
+  EXPECT_TRUE(v.Contains(Eigen::Vector3d(2.2, 2.2, 0.5)));    // along the box's long axis
   EXPECT_FALSE(v.Contains(Eigen::Vector3d(2.2, -0.2, 0.0)));  // across it
   EXPECT_FALSE(v.Contains(Eigen::Vector3d(1, 1, 1.5)));
 }

@@ -58,8 +58,8 @@ Status PerturbTrajectory(const Trajectory& gt, const TrajectoryPerturbation& p, 
   return Status::Ok();
 }
 
-Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p, std::vector<int>* predicted,
-                     int* expected_errors) {
+Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p,
+                     std::vector<int>* predicted, int* expected_errors) {
   std::mt19937_64 rng(p.seed);
   std::map<int, std::vector<size_t>> groups;
   for (size_t i = 0; i < truth.size(); ++i) groups[truth[i]].push_back(i);
@@ -101,11 +101,15 @@ Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p, 
     errors += p.split;
   }
   if (p.wrong > 0) {
-    if (movable_groups.size() < 2) return Status::Error("perturb labels: too few groups left to move points between");
+    if (movable_groups.size() < 2)
+      return Status::Error("perturb labels: too few groups left to move points between");
     size_t smallest = truth.size();
-    for (int g : movable_groups) smallest = std::min(smallest, groups[g].size() - (g == order.back() ? p.split : 0));
+    for (int g : movable_groups)
+      smallest = std::min(smallest, groups[g].size() - (g == order.back() ? p.split : 0));
     if (2 * (p.wrong + p.split) >= static_cast<int>(smallest)) {
-      return Status::Error("perturb labels: too many wrong labels for the group sizes (the best matching could change)");
+      return Status::Error(
+          "perturb labels: too many wrong labels for the group sizes (the best matching could "
+          "change)");
     }
     std::vector<size_t> candidates;
     for (int g : movable_groups) {

@@ -23,10 +23,10 @@ namespace mbslam {
 namespace eval {
 
 struct TrajectoryPerturbation {
-  Sim3d gt_from_est;            // the similarity S (est = S^-1 (gt + n))
-  double noise_sigma_m = 0.0;   // standard deviation of the position noise per axis (m, truth units)
+  Sim3d gt_from_est;           // the similarity S (est = S^-1 (gt + n))
+  double noise_sigma_m = 0.0;  // standard deviation of the position noise per axis (m, truth units)
   uint64_t seed = 1;
-  bool exact = true;            // make the noise orthogonal to the alignment (see above)
+  bool exact = true;  // make the noise orthogonal to the alignment (see above)
 };
 
 // `expected_ate_m`: the RMS of the injected noise (truth units), which is the Sim(3) ATE
@@ -35,18 +35,18 @@ Status PerturbTrajectory(const Trajectory& gt, const TrajectoryPerturbation& p, 
                          double* expected_ate_m);
 
 struct LabelPerturbation {
-  int wrong = 0;            // points moved to another (existing) group
-  int split = 0;            // points of the largest group given a new label
+  int wrong = 0;                // points moved to another (existing) group
+  int split = 0;                // points of the largest group given a new label
   bool merge_smallest = false;  // the two smallest groups get one label
-  bool permute = true;      // relabel the groups with shuffled, shifted values
+  bool permute = true;          // relabel the groups with shuffled, shifted values
   uint64_t seed = 1;
 };
 
 // `expected_errors`: the misclassification count the perturbation must produce. Fails
 // when the request could change which matching is optimal (too many errors for the
 // group sizes).
-Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p, std::vector<int>* predicted,
-                     int* expected_errors);
+Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p,
+                     std::vector<int>* predicted, int* expected_errors);
 
 }  // namespace eval
 }  // namespace mbslam

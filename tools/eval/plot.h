@@ -15,14 +15,15 @@ namespace mbslam {
 namespace eval {
 
 struct TopViewPlot {
-  int width = 900;          // image size (px)
-  int height = 700;         // (px)
+  int width = 900;   // image size (px)
+  int height = 700;  // (px)
   std::string title;
   bool draw_errors = true;  // a grey segment from each estimate pose to the truth at the same time
 };
 
 // Draws into a BGR image. The estimate should already be aligned to the truth.
-Status DrawTopView(const Trajectory& gt, const Trajectory& est_aligned, const TopViewPlot& options, cv::Mat* image);
+Status DrawTopView(const Trajectory& gt, const Trajectory& est_aligned, const TopViewPlot& options,
+                   cv::Mat* image);
 Status WriteTopView(const std::string& path, const Trajectory& gt, const Trajectory& est_aligned,
                     const TopViewPlot& options);
 

@@ -26,7 +26,8 @@ TEST(Plot, DrawsTruthAndEstimate) {
   Trajectory gt, est;
   for (int i = 0; i < 100; ++i) {
     const double a = 0.06 * i;
-    gt.push_back({i * 1000, Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(5 * std::cos(a), 3 * std::sin(a), 0.1))});
+    gt.push_back({i * 1000, Rigid3d(Eigen::Quaterniond::Identity(),
+                                    Eigen::Vector3d(5 * std::cos(a), 3 * std::sin(a), 0.1))});
     est.push_back({i * 1000, Rigid3d(Eigen::Quaterniond::Identity(),
                                      Eigen::Vector3d(5.3 * std::cos(a), 3.2 * std::sin(a), 0.1))});
   }

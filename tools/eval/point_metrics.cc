@@ -17,13 +17,15 @@ size_t NearestPoint::KeyHash::operator()(const Key& k) const {
 }
 
 NearestPoint::Key NearestPoint::KeyOf(const Eigen::Vector3d& p) const {
-  return {static_cast<int64_t>(std::floor(p.x() / cell_)), static_cast<int64_t>(std::floor(p.y() / cell_)),
+  return {static_cast<int64_t>(std::floor(p.x() / cell_)),
+          static_cast<int64_t>(std::floor(p.y() / cell_)),
           static_cast<int64_t>(std::floor(p.z() / cell_))};
 }
 
 NearestPoint::NearestPoint(const std::vector<Eigen::Vector3d>& points, double cell_m)
     : cell_(std::max(cell_m, 1e-6)), points_(points) {
-  for (size_t i = 0; i < points_.size(); ++i) cells_[KeyOf(points_[i])].push_back(static_cast<int>(i));
+  for (size_t i = 0; i < points_.size(); ++i)
+    cells_[KeyOf(points_[i])].push_back(static_cast<int>(i));
 }
 
 double NearestPoint::Distance(const Eigen::Vector3d& query, double max_distance) const {
@@ -36,10 +38,12 @@ double NearestPoint::Distance(const Eigen::Vector3d& query, double max_distance)
     for (int64_t dx = -r; dx <= r; ++dx) {
       for (int64_t dy = -r; dy <= r; ++dy) {
         for (int64_t dz = -r; dz <= r; ++dz) {
-          if (std::max({std::llabs(dx), std::llabs(dy), std::llabs(dz)}) != r) continue;  // the shell only
+          if (std::max({std::llabs(dx), std::llabs(dy), std::llabs(dz)}) != r)
+            continue;  // the shell only
           auto it = cells_.find({c.x + dx, c.y + dy, c.z + dz});
           if (it == cells_.end()) continue;
-          for (int i : it->second) best = std::min(best, (points_[static_cast<size_t>(i)] - query).norm());
+          for (int i : it->second)
+            best = std::min(best, (points_[static_cast<size_t>(i)] - query).norm());
         }
       }
     }

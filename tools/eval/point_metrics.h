@@ -42,9 +42,10 @@ class NearestPoint {
 };
 
 struct ReconstructionError {
-  ErrorStats accuracy;        // reconstructed point -> nearest true sample (m), capped at max_distance
-  double completeness = 0.0;  // fraction of true samples within `threshold` of a reconstructed point
-  int outliers = 0;           // reconstructed points farther than max_distance from the truth (count)
+  ErrorStats accuracy;  // reconstructed point -> nearest true sample (m), capped at max_distance
+  double completeness =
+      0.0;           // fraction of true samples within `threshold` of a reconstructed point
+  int outliers = 0;  // reconstructed points farther than max_distance from the truth (count)
 };
 
 ReconstructionError CompareToSurface(const std::vector<Eigen::Vector3d>& reconstructed,

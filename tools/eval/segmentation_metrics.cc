@@ -9,7 +9,8 @@
 namespace mbslam {
 namespace eval {
 
-MisclassificationResult Misclassification(const std::vector<int>& predicted, const std::vector<int>& truth) {
+MisclassificationResult Misclassification(const std::vector<int>& predicted,
+                                          const std::vector<int>& truth) {
   MisclassificationResult r;
   const size_t n = std::min(predicted.size(), truth.size());
   r.num_points = static_cast<int>(n);
@@ -37,7 +38,8 @@ MisclassificationResult Misclassification(const std::vector<int>& predicted, con
   for (const auto& p : pred_index) pred_labels[static_cast<size_t>(p.second)] = p.first;
   for (const auto& t : true_index) true_labels[static_cast<size_t>(t.second)] = t.first;
   for (size_t p = 0; p < assignment.size(); ++p) {
-    if (assignment[p] >= 0) r.pred_to_true[pred_labels[p]] = true_labels[static_cast<size_t>(assignment[p])];
+    if (assignment[p] >= 0)
+      r.pred_to_true[pred_labels[p]] = true_labels[static_cast<size_t>(assignment[p])];
   }
   r.num_errors = r.num_points - static_cast<int>(std::lround(matched));
   r.rate = static_cast<double>(r.num_errors) / static_cast<double>(r.num_points);
@@ -60,21 +62,32 @@ void PrecisionRecall::Add(const PrecisionRecall& o) {
   Finish();
 }
 
-PrecisionRecall MovingFeaturePrecisionRecall(const std::vector<LabelledFeature>& features, const cv::Mat& mask) {
+PrecisionRecall MovingFeaturePrecisionRecall(const std::vector<LabelledFeature>& features,
+                                             const cv::Mat& mask) {
   PrecisionRecall pr;
   for (const auto& f : features) {
     const int x = static_cast<int>(std::lround(f.u)), y = static_cast<int>(std::lround(f.v));
     if (x < 0 || y < 0 || x >= mask.cols || y >= mask.rows) continue;
     bool inside = false;
     switch (mask.depth()) {
-      case CV_8U: inside = mask.ptr<uint8_t>(y)[x * mask.channels()] != 0; break;
-      case CV_16U: inside = mask.ptr<uint16_t>(y)[x * mask.channels()] != 0; break;
-      default: inside = mask.at<float>(y, x) != 0.0f; break;
+      case CV_8U:
+        inside = mask.ptr<uint8_t>(y)[x * mask.channels()] != 0;
+        break;
+      case CV_16U:
+        inside = mask.ptr<uint16_t>(y)[x * mask.channels()] != 0;
+        break;
+      default:
+        inside = mask.at<float>(y, x) != 0.0f;
+        break;
     }
-    if (f.moving && inside) ++pr.true_positives;
-    else if (f.moving && !inside) ++pr.false_positives;
-    else if (!f.moving && inside) ++pr.false_negatives;
-    else ++pr.true_negatives;
+    if (f.moving && inside)
+      ++pr.true_positives;
+    else if (f.moving && !inside)
+      ++pr.false_positives;
+    else if (!f.moving && inside)
+      ++pr.false_negatives;
+    else
+      ++pr.true_negatives;
   }
   pr.Finish();
   return pr;

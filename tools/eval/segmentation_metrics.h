@@ -14,9 +14,9 @@ namespace mbslam {
 namespace eval {
 
 struct MisclassificationResult {
-  int num_points = 0;       // labelled points (count)
-  int num_errors = 0;       // points whose predicted group is not matched to their true group
-  double rate = 0.0;        // num_errors / num_points
+  int num_points = 0;  // labelled points (count)
+  int num_errors = 0;  // points whose predicted group is not matched to their true group
+  double rate = 0.0;   // num_errors / num_points
   int num_true_groups = 0;
   int num_pred_groups = 0;
   std::map<int, int> pred_to_true;  // the matching (predicted label -> true label)
@@ -25,7 +25,8 @@ struct MisclassificationResult {
 // Labels are arbitrary integers; a negative predicted label means "unassigned" and is
 // always an error. Predicted and true group counts may differ: unmatched groups' points
 // are errors.
-MisclassificationResult Misclassification(const std::vector<int>& predicted, const std::vector<int>& truth);
+MisclassificationResult Misclassification(const std::vector<int>& predicted,
+                                          const std::vector<int>& truth);
 
 struct PrecisionRecall {
   int true_positives = 0;
@@ -48,7 +49,8 @@ struct LabelledFeature {
 
 // A feature is a true positive if it is labelled moving and the mask is non-zero at its
 // pixel. Features outside the mask image are ignored.
-PrecisionRecall MovingFeaturePrecisionRecall(const std::vector<LabelledFeature>& features, const cv::Mat& mask);
+PrecisionRecall MovingFeaturePrecisionRecall(const std::vector<LabelledFeature>& features,
+                                             const cv::Mat& mask);
 
 // |A and B| / |A or B| of the non-zero pixels; 1 when both are empty.
 double RegionIoU(const cv::Mat& predicted, const cv::Mat& truth);

@@ -19,7 +19,8 @@ namespace {
 
 std::vector<int> Groups(const std::vector<int>& sizes) {
   std::vector<int> labels;
-  for (size_t g = 0; g < sizes.size(); ++g) labels.insert(labels.end(), static_cast<size_t>(sizes[g]), static_cast<int>(g + 1));
+  for (size_t g = 0; g < sizes.size(); ++g)
+    labels.insert(labels.end(), static_cast<size_t>(sizes[g]), static_cast<int>(g + 1));
   return labels;
 }
 
@@ -28,7 +29,8 @@ std::vector<int> Groups(const std::vector<int>& sizes) {
 int BruteForceErrors(const std::vector<int>& pred, const std::vector<int>& truth) {
   std::vector<int> p_labels, t_labels;
   for (int v : pred) {
-    if (v >= 0 && std::find(p_labels.begin(), p_labels.end(), v) == p_labels.end()) p_labels.push_back(v);
+    if (v >= 0 && std::find(p_labels.begin(), p_labels.end(), v) == p_labels.end())
+      p_labels.push_back(v);
   }
   for (int v : truth) {
     if (std::find(t_labels.begin(), t_labels.end(), v) == t_labels.end()) t_labels.push_back(v);
@@ -41,9 +43,11 @@ int BruteForceErrors(const std::vector<int>& pred, const std::vector<int>& truth
     int correct = 0;
     for (size_t i = 0; i < pred.size(); ++i) {
       if (pred[i] < 0) continue;
-      const size_t pi = static_cast<size_t>(std::find(p_labels.begin(), p_labels.end(), pred[i]) - p_labels.begin());
+      const size_t pi = static_cast<size_t>(std::find(p_labels.begin(), p_labels.end(), pred[i]) -
+                                            p_labels.begin());
       const int t = perm[pi];
-      if (t < static_cast<int>(t_labels.size()) && t_labels[static_cast<size_t>(t)] == truth[i]) ++correct;
+      if (t < static_cast<int>(t_labels.size()) && t_labels[static_cast<size_t>(t)] == truth[i])
+        ++correct;
     }
     best = std::max(best, correct);
   } while (std::next_permutation(perm.begin(), perm.end()));
@@ -164,7 +168,8 @@ TEST(Regions, IouAndPolygons) {
   EXPECT_DOUBLE_EQ(RegionIoU(a, a), 1.0);
   EXPECT_DOUBLE_EQ(RegionIoU(cv::Mat::zeros(5, 5, CV_8U), cv::Mat::zeros(5, 5, CV_8U)), 1.0);
   // A square hull from (9.5, 9.5) to (19.5, 19.5) covers the pixel centres 10..19.
-  const cv::Mat hull = RasterizePolygons({{{9.5f, 9.5f}, {19.5f, 9.5f}, {19.5f, 19.5f}, {9.5f, 19.5f}}}, cv::Size(30, 30));
+  const cv::Mat hull = RasterizePolygons(
+      {{{9.5f, 9.5f}, {19.5f, 9.5f}, {19.5f, 19.5f}, {9.5f, 19.5f}}}, cv::Size(30, 30));
   EXPECT_NEAR(cv::countNonZero(hull), 100, 22);
   EXPECT_EQ(hull.at<uint8_t>(15, 15), 255);
   EXPECT_EQ(hull.at<uint8_t>(25, 25), 0);

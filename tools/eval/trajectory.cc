@@ -46,10 +46,12 @@ Rigid3d PoseFromXyzQxyzw(const double v[7]) {
 
 std::string UtimeToSecondsString(int64_t utime) {
   const bool negative = utime < 0;
-  const uint64_t a = negative ? static_cast<uint64_t>(-(utime + 1)) + 1 : static_cast<uint64_t>(utime);
+  const uint64_t a =
+      negative ? static_cast<uint64_t>(-(utime + 1)) + 1 : static_cast<uint64_t>(utime);
   char buf[48];
   std::snprintf(buf, sizeof(buf), "%s%llu.%06llu", negative ? "-" : "",
-                static_cast<unsigned long long>(a / 1000000), static_cast<unsigned long long>(a % 1000000));
+                static_cast<unsigned long long>(a / 1000000),
+                static_cast<unsigned long long>(a % 1000000));
   return buf;
 }
 
@@ -109,17 +111,20 @@ Status ParseTumTrajectory(const std::string& text, Trajectory* trajectory) {
     const auto tokens = Tokens(line);
     if (tokens.empty()) continue;
     if (tokens.size() != 8) {
-      return Status::Error("line " + std::to_string(line_no) + ": expected 8 values (t tx ty tz qx qy qz qw), got " +
+      return Status::Error("line " + std::to_string(line_no) +
+                           ": expected 8 values (t tx ty tz qx qy qz qw), got " +
                            std::to_string(tokens.size()));
     }
     TimedPose p;
     if (!ParseSecondsToUtime(tokens[0], &p.utime)) {
-      return Status::Error("line " + std::to_string(line_no) + ": bad timestamp '" + tokens[0] + "'");
+      return Status::Error("line " + std::to_string(line_no) + ": bad timestamp '" + tokens[0] +
+                           "'");
     }
     double v[7];
     for (int k = 0; k < 7; ++k) {
       if (!ParseDouble(tokens[static_cast<size_t>(k + 1)], &v[k]) || !std::isfinite(v[k])) {
-        return Status::Error("line " + std::to_string(line_no) + ": bad number '" + tokens[static_cast<size_t>(k + 1)] + "'");
+        return Status::Error("line " + std::to_string(line_no) + ": bad number '" +
+                             tokens[static_cast<size_t>(k + 1)] + "'");
       }
     }
     const double qn = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
@@ -145,12 +150,14 @@ Status ReadTumTrajectory(const std::string& path, Trajectory* trajectory) {
 std::string FormatTumLine(int64_t utime, const Rigid3d& pose) {
   const Eigen::Quaterniond& q = pose.rotation;
   char buf[256];
-  std::snprintf(buf, sizeof(buf), "%s %.9f %.9f %.9f %.9f %.9f %.9f %.9f", UtimeToSecondsString(utime).c_str(),
-                pose.translation.x(), pose.translation.y(), pose.translation.z(), q.x(), q.y(), q.z(), q.w());
+  std::snprintf(buf, sizeof(buf), "%s %.9f %.9f %.9f %.9f %.9f %.9f %.9f",
+                UtimeToSecondsString(utime).c_str(), pose.translation.x(), pose.translation.y(),
+                pose.translation.z(), q.x(), q.y(), q.z(), q.w());
   return buf;
 }
 
-Status WriteTumTrajectory(const std::string& path, const Trajectory& trajectory, const std::string& header_comment) {
+Status WriteTumTrajectory(const std::string& path, const Trajectory& trajectory,
+                          const std::string& header_comment) {
   std::string text;
   if (!header_comment.empty()) text += "# " + header_comment + "\n";
   text += "# timestamp tx ty tz qx qy qz qw\n";
@@ -158,7 +165,8 @@ Status WriteTumTrajectory(const std::string& path, const Trajectory& trajectory,
   return WriteStringAtomically(path, text);
 }
 
-Status ReadTartanAirPoses(const std::string& path, int64_t frame_period_us, Trajectory* trajectory) {
+Status ReadTartanAirPoses(const std::string& path, int64_t frame_period_us,
+                          Trajectory* trajectory) {
   std::string text;
   MBSLAM_RETURN_IF_ERROR(ReadFileToString(path, &text));
   trajectory->clear();
@@ -176,7 +184,8 @@ Status ReadTartanAirPoses(const std::string& path, int64_t frame_period_us, Traj
     const auto tokens = Tokens(line);
     if (tokens.empty()) continue;
     if (tokens.size() != 7) {
-      return Status::Error(path + ":" + std::to_string(line_no) + ": expected 7 values (tx ty tz qx qy qz qw)");
+      return Status::Error(path + ":" + std::to_string(line_no) +
+                           ": expected 7 values (tx ty tz qx qy qz qw)");
     }
     double v[7];
     for (int k = 0; k < 7; ++k) {
@@ -192,7 +201,8 @@ Status ReadTartanAirPoses(const std::string& path, int64_t frame_period_us, Traj
   return Status::Ok();
 }
 
-std::vector<AssociatedPair> AssociateByTime(const Trajectory& est, const Trajectory& gt, int64_t max_dt_us) {
+std::vector<AssociatedPair> AssociateByTime(const Trajectory& est, const Trajectory& gt,
+                                            int64_t max_dt_us) {
   std::vector<AssociatedPair> candidates;
   if (gt.empty()) return candidates;
   for (size_t i = 0; i < est.size(); ++i) {
@@ -210,9 +220,10 @@ std::vector<AssociatedPair> AssociateByTime(const Trajectory& est, const Traject
       }
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(), [](const AssociatedPair& a, const AssociatedPair& b) {
-    return std::llabs(a.dt_us) < std::llabs(b.dt_us);
-  });
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const AssociatedPair& a, const AssociatedPair& b) {
+                     return std::llabs(a.dt_us) < std::llabs(b.dt_us);
+                   });
   std::vector<bool> est_used(est.size(), false), gt_used(gt.size(), false);
   std::vector<AssociatedPair> pairs;
   for (const auto& c : candidates) {
@@ -220,7 +231,8 @@ std::vector<AssociatedPair> AssociateByTime(const Trajectory& est, const Traject
     est_used[c.est] = gt_used[c.gt] = true;
     pairs.push_back(c);
   }
-  std::sort(pairs.begin(), pairs.end(), [](const AssociatedPair& a, const AssociatedPair& b) { return a.est < b.est; });
+  std::sort(pairs.begin(), pairs.end(),
+            [](const AssociatedPair& a, const AssociatedPair& b) { return a.est < b.est; });
   return pairs;
 }
 

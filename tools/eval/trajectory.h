@@ -42,11 +42,12 @@ Status ReadTartanAirPoses(const std::string& path, int64_t frame_period_us, Traj
 // One-to-one association of poses by time: for each estimate the ground-truth pose
 // nearest in time, if within max_dt_us; conflicts resolved by smallest time difference.
 struct AssociatedPair {
-  size_t est = 0;      // index into the estimate
-  size_t gt = 0;       // index into the ground truth
-  int64_t dt_us = 0;   // est time - gt time (µs)
+  size_t est = 0;     // index into the estimate
+  size_t gt = 0;      // index into the ground truth
+  int64_t dt_us = 0;  // est time - gt time (µs)
 };
-std::vector<AssociatedPair> AssociateByTime(const Trajectory& est, const Trajectory& gt, int64_t max_dt_us);
+std::vector<AssociatedPair> AssociateByTime(const Trajectory& est, const Trajectory& gt,
+                                            int64_t max_dt_us);
 
 // Sorts by time.
 void SortByTime(Trajectory* trajectory);

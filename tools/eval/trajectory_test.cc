@@ -45,11 +45,13 @@ TEST(Tum, ParseWriteRoundTrip) {
   ASSERT_EQ(t.size(), 2u);
   EXPECT_EQ(t[0].utime, 1341841278842700);  // sorted by time
   EXPECT_NEAR(t[0].pose.translation.x(), -2.5508, 1e-12);
-  EXPECT_NEAR(t[0].pose.rotation.w(), 0.2239 / std::sqrt(0.4871 * 0.4871 + 0.7673 * 0.7673 + 0.3519 * 0.3519 +
-                                                         0.2239 * 0.2239),
-              1e-12);
+  EXPECT_NEAR(
+      t[0].pose.rotation.w(),
+      0.2239 / std::sqrt(0.4871 * 0.4871 + 0.7673 * 0.7673 + 0.3519 * 0.3519 + 0.2239 * 0.2239),
+      1e-12);
   const std::string path = (std::filesystem::temp_directory_path() /
-                            ("mbslam_tum_" + std::to_string(::getpid()) + ".tum")).string();
+                            ("mbslam_tum_" + std::to_string(::getpid()) + ".tum"))
+                               .string();
   ASSERT_TRUE(WriteTumTrajectory(path, t, "test").ok());
   Trajectory back;
   ASSERT_TRUE(ReadTumTrajectory(path, &back).ok());
@@ -61,8 +63,9 @@ TEST(Tum, ParseWriteRoundTrip) {
   }
   std::filesystem::remove(path);
   EXPECT_FALSE(ParseTumTrajectory("1 2 3\n", &t).ok());
-  EXPECT_FALSE(ParseTumTrajectory("1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n", &t).ok());  // duplicate time
-  EXPECT_FALSE(ParseTumTrajectory("1 0 0 0 0 0 0 0\n", &t).ok());                  // zero quaternion
+  EXPECT_FALSE(
+      ParseTumTrajectory("1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n", &t).ok());  // duplicate time
+  EXPECT_FALSE(ParseTumTrajectory("1 0 0 0 0 0 0 0\n", &t).ok());          // zero quaternion
 }
 
 TEST(Association, NearestOneToOneWithinTolerance) {
@@ -87,7 +90,8 @@ TEST(Association, NearestOneToOneWithinTolerance) {
 
 TEST(TartanAir, NedToCameraAxes) {
   const std::string path = (std::filesystem::temp_directory_path() /
-                            ("mbslam_tartan_" + std::to_string(::getpid()) + ".txt")).string();
+                            ("mbslam_tartan_" + std::to_string(::getpid()) + ".txt"))
+                               .string();
   {
     FILE* f = std::fopen(path.c_str(), "w");
     ASSERT_NE(f, nullptr);

@@ -40,7 +40,8 @@ struct GtCheckOptions {
   }
   template <typename V>
   void VisitFields(V& v) {
-    v("max_samples_per_body", &max_samples_per_body, "ground-truth points checked per body and frame (count)");
+    v("max_samples_per_body", &max_samples_per_body,
+      "ground-truth points checked per body and frame (count)");
     v("pixel_stride", &pixel_stride, "ray-cast every n-th pixel in x and y (px)");
     v("border_px", &border_px, "ignore projections closer than this to the image border (px)");
   }
@@ -49,34 +50,44 @@ struct GtCheckOptions {
 struct GtCheckReport {
   int frames = 0;
   // Surface samples.
-  int64_t samples_visible = 0;          // visible samples that were checked (count)
-  int64_t samples_visible_moving = 0;   // ... of them on moving bodies (count)
-  int64_t label_failures = 0;           // visible samples with label error > 0.5 px (count)
-  double label_max_px = 0.0;            // largest label error (px)
-  int64_t reprojection_samples = 0;     // samples in planar 3x3 neighbourhoods (count)
-  double reprojection_max_px = 0.0;     // largest sub-pixel reprojection error (px)
-  double reprojection_rms_px = 0.0;     // RMS of it (px)
-  double surface_max_distance_m = 0.0;  // largest distance of a sample from the rendered surface (m)
-  double depth_at_sample_max_rel = 0.0; // largest |rendered depth - sample depth| / depth at interior samples
+  int64_t samples_visible = 0;         // visible samples that were checked (count)
+  int64_t samples_visible_moving = 0;  // ... of them on moving bodies (count)
+  int64_t label_failures = 0;          // visible samples with label error > 0.5 px (count)
+  double label_max_px = 0.0;           // largest label error (px)
+  int64_t reprojection_samples = 0;    // samples in planar 3x3 neighbourhoods (count)
+  double reprojection_max_px = 0.0;    // largest sub-pixel reprojection error (px)
+  double reprojection_rms_px = 0.0;    // RMS of it (px)
+  double surface_max_distance_m =
+      0.0;  // largest distance of a sample from the rendered surface (m)
+  double depth_at_sample_max_rel =
+      0.0;  // largest |rendered depth - sample depth| / depth at interior samples
   // Pixel grid.
-  int64_t pixels = 0;                   // pixels ray-cast (count)
-  int64_t pixel_label_mismatches = 0;   // rendered id != ray-cast id (count)
-  int64_t pixel_label_mismatches_on_edges = 0;  // ... of them within 0.02 px of a silhouette (count)
-  int64_t pixel_depth_skipped_on_edges = 0;     // same id, depth of a surface 0.02 px away (count)
-  double depth_max_abs_error_m = 0.0;   // largest |rendered depth - ray-cast depth| (m)
-  double depth_max_rel_error = 0.0;     // largest relative depth error
-  double pixel_backprojection_max_px = 0.0;  // largest |project(rendered point) - pixel centre| (px)
+  int64_t pixels = 0;                  // pixels ray-cast (count)
+  int64_t pixel_label_mismatches = 0;  // rendered id != ray-cast id (count)
+  int64_t pixel_label_mismatches_on_edges =
+      0;                                     // ... of them within 0.02 px of a silhouette (count)
+  int64_t pixel_depth_skipped_on_edges = 0;  // same id, depth of a surface 0.02 px away (count)
+  int64_t pixel_depth_grazing =
+      0;  // grazing views (depth changes > 1 % per pixel) off by > 1e-5 (count)
+  double depth_max_abs_error_m =
+      0.0;  // largest |rendered - ray-cast depth|, not at grazing views (m)
+  double depth_max_rel_error = 0.0;  // largest relative depth error, not at grazing views
+  double depth_max_error_px = 0.0;  // largest depth error as an image displacement, all pixels (px)
+  double pixel_backprojection_max_px =
+      0.0;  // largest |project(rendered point) - pixel centre| (px)
 
   // The headline figure: max(label_max_px, reprojection_max_px).
-  double MaxErrorPx() const { return label_max_px > reprojection_max_px ? label_max_px : reprojection_max_px; }
+  double MaxErrorPx() const {
+    return label_max_px > reprojection_max_px ? label_max_px : reprojection_max_px;
+  }
   void Merge(const GtCheckReport& other);
   std::string ToJson() const;
 };
 
 // Checks one frame rendered with RenderFrame (image not needed, geometry required) and
 // adds to `report`.
-Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame, const GtCheckOptions& options,
-                             GtCheckReport* report);
+Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
+                             const GtCheckOptions& options, GtCheckReport* report);
 
 }  // namespace sim
 }  // namespace mbslam

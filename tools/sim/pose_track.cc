@@ -109,9 +109,7 @@ PlanarPath& PlanarPath::Turn(double angle_rad, double yaw_rate_abs) {
   return *this;
 }
 
-double PlanarPath::duration_s() const {
-  return static_cast<double>(knots_.size() - 1) * kStepS;
-}
+double PlanarPath::duration_s() const { return static_cast<double>(knots_.size() - 1) * kStepS; }
 
 PlanarPath::State PlanarPath::At(double t_s) const {
   if (t_s <= 0.0) {
@@ -172,14 +170,14 @@ Rigid3d ForwardCameraMount(const Eigen::Vector3d& translation, double pitch_down
   Eigen::Matrix3d base_from_cam_level;
   base_from_cam_level << 0, 0, 1, -1, 0, 0, 0, -1, 0;
   // Pitch down: rotate about base y (left axis) by +pitch (x forward tilts towards -z).
-  const Eigen::Matrix3d yaw = Eigen::AngleAxisd(yaw_left_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d yaw =
+      Eigen::AngleAxisd(yaw_left_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Matrix3d pitch =
       Eigen::AngleAxisd(pitch_down_rad, Eigen::Vector3d::UnitY()).toRotationMatrix();
   return Rigid3d(Eigen::Matrix3d(yaw * pitch * base_from_cam_level), translation);
 }
 
-SmoothNoise3::SmoothNoise3(uint64_t seed, double rms, double f_min_hz, double f_max_hz,
-                           int terms) {
+SmoothNoise3::SmoothNoise3(uint64_t seed, double rms, double f_min_hz, double f_max_hz, int terms) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> freq(f_min_hz, f_max_hz);
   std::uniform_real_distribution<double> phase(0.0, 2.0 * M_PI);

@@ -20,7 +20,8 @@ namespace sim {
 // Pose and velocity of a body at one time.
 struct MotionState {
   Rigid3d world_from_body;
-  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   // of the body origin, world frame (m/s)
+  Eigen::Vector3d linear_velocity =
+      Eigen::Vector3d::Zero();  // of the body origin, world frame (m/s)
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // world frame (rad/s)
 };
 
@@ -42,7 +43,9 @@ class PoseTrack {
 
   bool empty() const { return samples_.empty(); }
   int64_t begin_utime() const { return begin_utime_; }
-  int64_t end_utime() const { return begin_utime_ + step_us_ * static_cast<int64_t>(samples_.size() - 1); }
+  int64_t end_utime() const {
+    return begin_utime_ + step_us_ * static_cast<int64_t>(samples_.size() - 1);
+  }
 
  private:
   int64_t begin_utime_ = 0;

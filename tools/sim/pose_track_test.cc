@@ -67,11 +67,15 @@ TEST(PoseTrack, InterpolatesAndDifferentiates) {
 TEST(ForwardCameraMount, AxesLookAlongBaseX) {
   const Rigid3d base_from_cam = ForwardCameraMount(Eigen::Vector3d(0.1, 0.0, 0.5), 0.0);
   const Eigen::Matrix3d R = base_from_cam.RotationMatrix();
-  EXPECT_LT((R * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(), 1e-12);   // optical axis forward
-  EXPECT_LT((R * Eigen::Vector3d::UnitX() + Eigen::Vector3d::UnitY()).norm(), 1e-12);   // image right = base right
-  EXPECT_LT((R * Eigen::Vector3d::UnitY() + Eigen::Vector3d::UnitZ()).norm(), 1e-12);   // image down = base down
+  EXPECT_LT((R * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(),
+            1e-12);  // optical axis forward
+  EXPECT_LT((R * Eigen::Vector3d::UnitX() + Eigen::Vector3d::UnitY()).norm(),
+            1e-12);  // image right = base right
+  EXPECT_LT((R * Eigen::Vector3d::UnitY() + Eigen::Vector3d::UnitZ()).norm(),
+            1e-12);  // image down = base down
   const Rigid3d pitched = ForwardCameraMount(Eigen::Vector3d::Zero(), 0.2);
-  EXPECT_NEAR((pitched.rotation * Eigen::Vector3d::UnitZ()).z(), -std::sin(0.2), 1e-12);  // looks down
+  EXPECT_NEAR((pitched.rotation * Eigen::Vector3d::UnitZ()).z(), -std::sin(0.2),
+              1e-12);  // looks down
 }
 
 TEST(SmoothNoise3, HasRequestedRmsAndIsDeterministic) {

@@ -14,7 +14,9 @@ namespace {
 class Rng {
  public:
   explicit Rng(uint64_t seed) : engine_(seed) {}
-  double Uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(engine_); }
+  double Uniform(double a, double b) {
+    return std::uniform_real_distribution<double>(a, b)(engine_);
+  }
   // Log-uniform in [a, b] (a, b > 0): as many small features as large ones per octave.
   double LogUniform(double a, double b) { return std::exp(Uniform(std::log(a), std::log(b))); }
   double Normal(double sigma) { return std::normal_distribution<double>(0.0, sigma)(engine_); }
@@ -45,7 +47,8 @@ cv::Scalar Gray(double v) { return cv::Scalar(v, v, v); }
 
 // One of a few natural base colours (BGR), brightness-varied, with a slight hue jitter.
 cv::Scalar FromPalette(Rng* rng, const std::vector<cv::Scalar>& palette, double lo, double hi) {
-  return Vary(rng, palette[static_cast<size_t>(rng->Int(0, static_cast<int>(palette.size()) - 1))], lo, hi, 0.015);
+  return Vary(rng, palette[static_cast<size_t>(rng->Int(0, static_cast<int>(palette.size()) - 1))],
+              lo, hi, 0.015);
 }
 
 const std::vector<cv::Scalar> kStonePalette = {
@@ -65,8 +68,9 @@ const std::vector<cv::Scalar> kFacadePalette = {
 
 cv::Scalar RandomSaturated(Rng* rng) {
   // A random fairly saturated colour, built in HSV.
-  cv::Mat hsv(1, 1, CV_32FC3, cv::Scalar(rng->Uniform(0.0, 360.0), rng->Uniform(0.4, 0.9),
-                                         rng->Uniform(0.35, 0.95)));
+  cv::Mat hsv(
+      1, 1, CV_32FC3,
+      cv::Scalar(rng->Uniform(0.0, 360.0), rng->Uniform(0.4, 0.9), rng->Uniform(0.35, 0.95)));
   cv::Mat bgr;
   cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
   const cv::Vec3f v = bgr.at<cv::Vec3f>(0, 0);
@@ -108,17 +112,18 @@ void DrawBlobs(cv::Mat* img, Rng* rng, int count, double min_px, double max_px, 
     const cv::Scalar col = color(rng);
     const int type = rng->Int(0, 2);
     if (type == 0) {
-      const cv::Size axes(std::max(1, cvRound(r)), std::max(1, cvRound(r * rng->Uniform(0.3, 1.0))));
+      const cv::Size axes(std::max(1, cvRound(r)),
+                          std::max(1, cvRound(r * rng->Uniform(0.3, 1.0))));
       cv::ellipse(*img, cv::Point(cvRound(c.x), cvRound(c.y)), axes, rng->Uniform(0.0, 180.0), 0.0,
                   360.0, col, cv::FILLED);
     } else if (type == 1) {
       const std::vector<std::vector<cv::Point>> poly{IrregularPolygon(rng, c, r)};
       cv::fillPoly(*img, poly, col);
     } else {
-      const cv::RotatedRect rect(cv::Point2f(static_cast<float>(c.x), static_cast<float>(c.y)),
-                                 cv::Size2f(static_cast<float>(2 * r),
-                                            static_cast<float>(2 * r * rng->Uniform(0.2, 1.0))),
-                                 static_cast<float>(rng->Uniform(0.0, 180.0)));
+      const cv::RotatedRect rect(
+          cv::Point2f(static_cast<float>(c.x), static_cast<float>(c.y)),
+          cv::Size2f(static_cast<float>(2 * r), static_cast<float>(2 * r * rng->Uniform(0.2, 1.0))),
+          static_cast<float>(rng->Uniform(0.0, 180.0)));
       cv::Point2f corners[4];
       rect.points(corners);
       std::vector<cv::Point> pts;
@@ -155,15 +160,16 @@ int CountFor(const cv::Mat& img, double per_megapixel) {
 // Irregular stones: Voronoi cells of random sites, each with its own shade, dark joints.
 void DrawVoronoiStones(cv::Mat* img, Rng* rng, double stone_px, const cv::Scalar& base,
                        double joint_px) {
-  const cv::Rect2f bounds(-2.0f * static_cast<float>(stone_px), -2.0f * static_cast<float>(stone_px),
-                          static_cast<float>(img->cols + 4 * stone_px),
-                          static_cast<float>(img->rows + 4 * stone_px));
-  cv::Subdiv2D subdiv(cv::Rect(cvFloor(bounds.x), cvFloor(bounds.y), cvCeil(bounds.width),
-                               cvCeil(bounds.height)));
+  const cv::Rect2f bounds(
+      -2.0f * static_cast<float>(stone_px), -2.0f * static_cast<float>(stone_px),
+      static_cast<float>(img->cols + 4 * stone_px), static_cast<float>(img->rows + 4 * stone_px));
+  cv::Subdiv2D subdiv(
+      cv::Rect(cvFloor(bounds.x), cvFloor(bounds.y), cvCeil(bounds.width), cvCeil(bounds.height)));
   const int n = std::max(4, static_cast<int>(bounds.area() / (stone_px * stone_px)));
   for (int i = 0; i < n; ++i) {
-    subdiv.insert(cv::Point2f(static_cast<float>(rng->Uniform(bounds.x + 1, bounds.x + bounds.width - 1)),
-                              static_cast<float>(rng->Uniform(bounds.y + 1, bounds.y + bounds.height - 1))));
+    subdiv.insert(
+        cv::Point2f(static_cast<float>(rng->Uniform(bounds.x + 1, bounds.x + bounds.width - 1)),
+                    static_cast<float>(rng->Uniform(bounds.y + 1, bounds.y + bounds.height - 1))));
   }
   std::vector<std::vector<cv::Point2f>> facets;
   std::vector<cv::Point2f> centers;
@@ -182,14 +188,22 @@ void DrawVoronoiStones(cv::Mat* img, Rng* rng, double stone_px, const cv::Scalar
 
 const char* TextureStyleName(TextureStyle style) {
   switch (style) {
-    case TextureStyle::kAsphalt: return "asphalt";
-    case TextureStyle::kGrass: return "grass";
-    case TextureStyle::kPaving: return "paving";
-    case TextureStyle::kFacade: return "facade";
-    case TextureStyle::kConcrete: return "concrete";
-    case TextureStyle::kVehicle: return "vehicle";
-    case TextureStyle::kClothing: return "clothing";
-    case TextureStyle::kCrate: return "crate";
+    case TextureStyle::kAsphalt:
+      return "asphalt";
+    case TextureStyle::kGrass:
+      return "grass";
+    case TextureStyle::kPaving:
+      return "paving";
+    case TextureStyle::kFacade:
+      return "facade";
+    case TextureStyle::kConcrete:
+      return "concrete";
+    case TextureStyle::kVehicle:
+      return "vehicle";
+    case TextureStyle::kClothing:
+      return "clothing";
+    case TextureStyle::kCrate:
+      return "crate";
   }
   return "unknown";
 }
@@ -219,7 +233,8 @@ cv::Mat FractalNoise(int width, int height, uint64_t seed, double largest_cell_p
       cv::resize(grid, up, cv::Size(cvRound(gw * cell), cvRound(gh * cell)), 0, 0, cv::INTER_CUBIC);
       const int ox = static_cast<int>(rng.Uniform(cell, 2.0 * cell));
       const int oy = static_cast<int>(rng.Uniform(cell, 2.0 * cell));
-      sum += amplitude * up(cv::Rect(std::min(ox, up.cols - width), std::min(oy, up.rows - height), width, height));
+      sum += amplitude * up(cv::Rect(std::min(ox, up.cols - width), std::min(oy, up.rows - height),
+                                     width, height));
     }
     amplitude *= persistence;
     cell *= 0.5;
@@ -243,7 +258,8 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
 
   cv::Mat img(height, width, CV_32FC3);
   const cv::Mat low = FractalNoise(width, height, rng.Next(), std::min(px(2.0), max_dim), 4, 0.6);
-  const cv::Mat grain = FractalNoise(width, height, rng.Next(), std::min(px(0.08), max_dim), 5, 0.7);
+  const cv::Mat grain =
+      FractalNoise(width, height, rng.Next(), std::min(px(0.08), max_dim), 5, 0.7);
 
   switch (style) {
     case TextureStyle::kAsphalt: {
@@ -254,8 +270,9 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
       DrawBlobs(&img, &rng, CountFor(img, 12), px(0.3), px(1.5),
                 [&](Rng* r) { return Vary(r, base, 0.6, 1.4, 0.01); });
       // Gravel: many small light and dark stones.
-      DrawBlobs(&img, &rng, CountFor(img, 9000), 1.0, std::max(1.5, px(0.025)),
-                [&](Rng* r) { return Gray(r->Chance(0.5) ? r->Uniform(0.05, 0.2) : r->Uniform(0.5, 0.8)); });
+      DrawBlobs(&img, &rng, CountFor(img, 9000), 1.0, std::max(1.5, px(0.025)), [&](Rng* r) {
+        return Gray(r->Chance(0.5) ? r->Uniform(0.05, 0.2) : r->Uniform(0.5, 0.8));
+      });
       // Faded paint marks.
       DrawBlobs(&img, &rng, CountFor(img, 3), px(0.1), px(0.6), [&](Rng* r) {
         return r->Chance(0.7) ? Gray(r->Uniform(0.7, 0.9)) : cv::Scalar(0.2, 0.75, 0.85);
@@ -269,12 +286,14 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
       const cv::Scalar base(0.12, 0.45, 0.25);
       img.setTo(base);
       Modulate(&img, low, 0.3);
-      DrawBlobs(&img, &rng, CountFor(img, 25), px(0.1), px(0.9),
-                [&](Rng* r) { return Vary(r, cv::Scalar(0.2, 0.35, 0.45), 0.6, 1.3, 0.03); });  // dirt
+      DrawBlobs(&img, &rng, CountFor(img, 25), px(0.1), px(0.9), [&](Rng* r) {
+        return Vary(r, cv::Scalar(0.2, 0.35, 0.45), 0.6, 1.3, 0.03);
+      });  // dirt
       DrawCracks(&img, &rng, CountFor(img, 6000), 2.0, std::max(3.0, px(0.08)), 1,
                  [&](Rng* r) { return Vary(r, base, 0.4, 1.8, 0.04); });  // blades
-      DrawBlobs(&img, &rng, CountFor(img, 800), 1.0, std::max(1.5, px(0.03)),
-                [&](Rng* r) { return r->Chance(0.2) ? cv::Scalar(0.2, 0.85, 0.9) : Vary(r, base, 0.3, 1.6, 0.05); });
+      DrawBlobs(&img, &rng, CountFor(img, 800), 1.0, std::max(1.5, px(0.03)), [&](Rng* r) {
+        return r->Chance(0.2) ? cv::Scalar(0.2, 0.85, 0.9) : Vary(r, base, 0.3, 1.6, 0.05);
+      });
       Modulate(&img, grain, 0.3);
       break;
     }
@@ -291,7 +310,8 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
       break;
     }
     case TextureStyle::kFacade: {
-      const cv::Scalar base = have_tint ? Clamp01(tint) : FromPalette(&rng, kFacadePalette, 0.8, 1.15);
+      const cv::Scalar base =
+          have_tint ? Clamp01(tint) : FromPalette(&rng, kFacadePalette, 0.8, 1.15);
       img.setTo(base);
       Modulate(&img, low, 0.15);
       // Irregular windows: floors of varying height, windows of varying width and spacing.
@@ -306,17 +326,21 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
             const cv::Rect r(cvRound(x), cvRound(y), cvRound(win_w), cvRound(win_h));
             cv::rectangle(img, r, Vary(&rng, base, 0.4, 0.6, 0.02), cv::FILLED);  // frame
             const int f = std::max(1, cvRound(px(0.06)));
-            const cv::Rect glass(r.x + f, r.y + f, std::max(1, r.width - 2 * f), std::max(1, r.height - 2 * f));
-            cv::rectangle(img, glass, Vary(&rng, cv::Scalar(0.45, 0.35, 0.25), 0.4, 1.4, 0.05), cv::FILLED);
+            const cv::Rect glass(r.x + f, r.y + f, std::max(1, r.width - 2 * f),
+                                 std::max(1, r.height - 2 * f));
+            cv::rectangle(img, glass, Vary(&rng, cv::Scalar(0.45, 0.35, 0.25), 0.4, 1.4, 0.05),
+                          cv::FILLED);
             // Reflections / curtains inside the glass.
             cv::Mat roi = img(glass & cv::Rect(0, 0, width, height));
             if (!roi.empty()) {
               DrawBlobs(&roi, &rng, rng.Int(1, 4), std::max(1.0, glass.width * 0.1),
-                        std::max(2.0, glass.width * 0.5),
-                        [&](Rng* r) { return Vary(r, cv::Scalar(0.6, 0.55, 0.5), 0.3, 1.6, 0.08); });
+                        std::max(2.0, glass.width * 0.5), [&](Rng* r) {
+                          return Vary(r, cv::Scalar(0.6, 0.55, 0.5), 0.3, 1.6, 0.08);
+                        });
             }
             if (rng.Chance(0.5)) {  // mullion
-              cv::line(img, cv::Point(r.x + r.width / 2, r.y), cv::Point(r.x + r.width / 2, r.y + r.height),
+              cv::line(img, cv::Point(r.x + r.width / 2, r.y),
+                       cv::Point(r.x + r.width / 2, r.y + r.height),
                        Vary(&rng, base, 0.4, 0.6, 0.02), f);
             }
           }
@@ -324,8 +348,9 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
         }
         y += floor_h;
       }
-      DrawBlobs(&img, &rng, CountFor(img, 40), px(0.1), px(1.2),
-                [&](Rng* r) { return r->Chance(0.3) ? RandomSaturated(r) : Vary(r, base, 0.55, 1.3, 0.03); });
+      DrawBlobs(&img, &rng, CountFor(img, 40), px(0.1), px(1.2), [&](Rng* r) {
+        return r->Chance(0.3) ? RandomSaturated(r) : Vary(r, base, 0.55, 1.3, 0.03);
+      });
       DrawBlobs(&img, &rng, CountFor(img, 2500), 1.0, std::max(1.5, px(0.03)),
                 [&](Rng* r) { return Vary(r, base, 0.4, 1.5, 0.03); });
       DrawCracks(&img, &rng, CountFor(img, 40), px(0.2), px(2.5), 2,
@@ -339,7 +364,8 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
       Modulate(&img, low, 0.2);
       // Formwork seams at irregular spacing.
       for (double x = px(rng.Uniform(0.2, 1.0)); x < width; x += px(rng.Uniform(0.6, 1.6))) {
-        cv::line(img, cv::Point(cvRound(x), 0), cv::Point(cvRound(x + rng.Normal(px(0.05))), height),
+        cv::line(img, cv::Point(cvRound(x), 0),
+                 cv::Point(cvRound(x + rng.Normal(px(0.05))), height),
                  Vary(&rng, base, 0.55, 0.75, 0.02), std::max(1, cvRound(px(0.01))));
       }
       DrawBlobs(&img, &rng, CountFor(img, 30), px(0.05), px(0.6),
@@ -363,10 +389,12 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
         cv::line(img, cv::Point(0, y0), cv::Point(width, y0 + rng.Int(-height / 4, height / 4)),
                  RandomSaturated(&rng), std::max(1, cvRound(px(rng.Uniform(0.02, 0.15)))));
       }
-      DrawBlobs(&img, &rng, CountFor(img, 80), px(0.03), px(0.35),
-                [&](Rng* r) { return r->Chance(0.5) ? RandomSaturated(r) : Gray(r->Uniform(0.0, 1.0)); });
-      DrawBlobs(&img, &rng, CountFor(img, 6000), 1.0, std::max(1.5, px(0.025)),
-                [&](Rng* r) { return Vary(r, cv::Scalar(0.3, 0.38, 0.45), 0.5, 1.5, 0.05); });  // dirt
+      DrawBlobs(&img, &rng, CountFor(img, 80), px(0.03), px(0.35), [&](Rng* r) {
+        return r->Chance(0.5) ? RandomSaturated(r) : Gray(r->Uniform(0.0, 1.0));
+      });
+      DrawBlobs(&img, &rng, CountFor(img, 6000), 1.0, std::max(1.5, px(0.025)), [&](Rng* r) {
+        return Vary(r, cv::Scalar(0.3, 0.38, 0.45), 0.5, 1.5, 0.05);
+      });  // dirt
       DrawCracks(&img, &rng, CountFor(img, 100), px(0.03), px(0.5), 1,
                  [&](Rng* r) { return Vary(r, base, 0.3, 1.7, 0.05); });  // scratches, panel gaps
       Modulate(&img, grain, 0.22);
@@ -383,11 +411,12 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
       for (double s = -max_dim; s < 2 * max_dim; s += stripe * rng.Uniform(2.0, 6.0)) {
         const cv::Point2d n(-dir.y, dir.x);
         const cv::Point2d c = n * s;
-        cv::line(img, c - dir * 2.0 * max_dim, c + dir * 2.0 * max_dim, Vary(&rng, second, 0.7, 1.2, 0.05),
-                 std::max(1, cvRound(stripe)));
+        cv::line(img, c - dir * 2.0 * max_dim, c + dir * 2.0 * max_dim,
+                 Vary(&rng, second, 0.7, 1.2, 0.05), std::max(1, cvRound(stripe)));
       }
-      DrawBlobs(&img, &rng, CountFor(img, 300), px(0.02), px(0.15),
-                [&](Rng* r) { return r->Chance(0.5) ? RandomSaturated(r) : Vary(r, base, 0.3, 1.6, 0.05); });
+      DrawBlobs(&img, &rng, CountFor(img, 300), px(0.02), px(0.15), [&](Rng* r) {
+        return r->Chance(0.5) ? RandomSaturated(r) : Vary(r, base, 0.3, 1.6, 0.05);
+      });
       DrawCracks(&img, &rng, CountFor(img, 400), px(0.03), px(0.3), 2,
                  [&](Rng* r) { return Vary(r, base, 0.3, 0.6, 0.03); });  // folds, seams
       DrawBlobs(&img, &rng, CountFor(img, 4000), 1.0, std::max(1.5, px(0.01)),
@@ -413,8 +442,9 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
       Modulate(&img, streak, 0.2);
       DrawBlobs(&img, &rng, CountFor(img, 150), 1.5, std::max(2.0, px(0.03)),
                 [&](Rng* r) { return Vary(r, base, 0.3, 0.6, 0.03); });  // knots, nails
-      DrawBlobs(&img, &rng, CountFor(img, 20), px(0.05), px(0.25),
-                [&](Rng* r) { return r->Chance(0.5) ? Gray(0.1) : RandomSaturated(r); });  // stencils
+      DrawBlobs(&img, &rng, CountFor(img, 20), px(0.05), px(0.25), [&](Rng* r) {
+        return r->Chance(0.5) ? Gray(0.1) : RandomSaturated(r);
+      });  // stencils
       DrawCracks(&img, &rng, CountFor(img, 60), px(0.05), px(0.4), 1,
                  [&](Rng* r) { return Vary(r, base, 0.3, 0.6, 0.03); });
       Modulate(&img, grain, 0.15);

@@ -10,9 +10,9 @@ namespace mbslam {
 namespace sim {
 namespace {
 
-const TextureStyle kStyles[] = {TextureStyle::kAsphalt,  TextureStyle::kGrass,   TextureStyle::kPaving,
-                                TextureStyle::kFacade,   TextureStyle::kConcrete, TextureStyle::kVehicle,
-                                TextureStyle::kClothing, TextureStyle::kCrate};
+const TextureStyle kStyles[] = {
+    TextureStyle::kAsphalt,  TextureStyle::kGrass,   TextureStyle::kPaving,   TextureStyle::kFacade,
+    TextureStyle::kConcrete, TextureStyle::kVehicle, TextureStyle::kClothing, TextureStyle::kCrate};
 
 TEST(ProceduralTexture, DeterministicPerSeed) {
   for (TextureStyle style : kStyles) {
@@ -35,7 +35,8 @@ TEST(ProceduralTexture, RichInCornersAtEveryScale) {
     for (int level = 0; level < 3; ++level) {
       std::vector<cv::KeyPoint> kps;
       cv::FAST(gray, kps, 12, true);
-      const double per_10k_px = 1e4 * static_cast<double>(kps.size()) / static_cast<double>(gray.total());
+      const double per_10k_px =
+          1e4 * static_cast<double>(kps.size()) / static_cast<double>(gray.total());
       EXPECT_GT(per_10k_px, 5.0) << TextureStyleName(style) << " level " << level;
       cv::pyrDown(gray, gray);
     }
@@ -57,14 +58,16 @@ TEST(ProceduralTexture, NoRepetitivePattern) {
         cv::Mat score;
         cv::matchTemplate(gray, gray(patch), score, cv::TM_CCOEFF_NORMED);
         EXPECT_NEAR(score.at<float>(patch.y, patch.x), 1.0, 1e-4);
-        cv::rectangle(score, cv::Rect(patch.x - 10, patch.y - 10, 21, 21), cv::Scalar(-1), cv::FILLED);
+        cv::rectangle(score, cv::Rect(patch.x - 10, patch.y - 10, 21, 21), cv::Scalar(-1),
+                      cv::FILLED);
         double b;
         cv::minMaxLoc(score, nullptr, &b);
         best.push_back(b);
       }
     }
     std::sort(best.begin(), best.end());
-    RecordProperty(std::string("median_best_ncc_") + TextureStyleName(style), std::to_string(best[best.size() / 2]));
+    RecordProperty(std::string("median_best_ncc_") + TextureStyleName(style),
+                   std::to_string(best[best.size() / 2]));
     EXPECT_LT(best[best.size() / 2], 0.85) << TextureStyleName(style);
   }
   // The test can fail: a tiled texture repeats.

@@ -1,9 +1,9 @@
 #include "tools/sim/renderer.h"
 
 #define GL_GLEXT_PROTOTYPES 1
-#include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <GL/osmesa.h>
 
 #include <opencv2/imgproc.hpp>
 
@@ -135,8 +135,8 @@ struct Renderer::Impl {
   GLuint vao = 0, vbo = 0;
   std::vector<GLuint> textures;
   GLuint detail_texture = 0;
-  GLuint color_fbo = 0, color_rb = 0, color_depth_rb = 0;      // possibly multisampled
-  GLuint resolve_fbo = 0, resolve_rb = 0;                      // single-sample colour
+  GLuint color_fbo = 0, color_rb = 0, color_depth_rb = 0;  // possibly multisampled
+  GLuint resolve_fbo = 0, resolve_rb = 0;                  // single-sample colour
   GLuint geometry_fbo = 0, geometry_rb = 0, geometry_depth_rb = 0;
   std::vector<QuadDraw> draws;
   Eigen::Matrix4d cam_to_clip = Eigen::Matrix4d::Zero();
@@ -145,7 +145,8 @@ struct Renderer::Impl {
   ~Impl() {
     if (!context) return;
     if (MakeCurrent()) {
-      if (!textures.empty()) glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+      if (!textures.empty())
+        glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
       glDeleteTextures(1, &detail_texture);
       GLuint rbs[] = {color_rb, color_depth_rb, resolve_rb, geometry_rb, geometry_depth_rb};
       glDeleteRenderbuffers(5, rbs);
@@ -167,9 +168,17 @@ struct Renderer::Impl {
   }
 
   Status Init() {
-    const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0,
-                           OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 4,
-                           OSMESA_CONTEXT_MINOR_VERSION, 5, 0};
+    const int attribs[] = {OSMESA_FORMAT,
+                           OSMESA_RGBA,
+                           OSMESA_DEPTH_BITS,
+                           0,
+                           OSMESA_PROFILE,
+                           OSMESA_CORE_PROFILE,
+                           OSMESA_CONTEXT_MAJOR_VERSION,
+                           4,
+                           OSMESA_CONTEXT_MINOR_VERSION,
+                           5,
+                           0};
     context = OSMesaCreateContextAttribs(attribs, nullptr);
     if (!context) return Status::Error("OSMesa: cannot create a GL 4.5 core context");
     default_buffer.assign(4 * 4 * 4, 0);
@@ -187,11 +196,12 @@ struct Renderer::Impl {
     const double w = intrinsics.width, h = intrinsics.height;
     cam_to_clip << 2.0 * intrinsics.fx / w, 0.0, 2.0 * (intrinsics.cx + 0.5) / w - 1.0, 0.0,  //
         0.0, -2.0 * intrinsics.fy / h, 1.0 - 2.0 * (intrinsics.cy + 0.5) / h, 0.0,            //
-        0.0, 0.0, 0.0, options.near_m,                                                         //
+        0.0, 0.0, 0.0, options.near_m,                                                        //
         0.0, 0.0, 1.0, 0.0;
     // glClipControl (GL 4.5) is not exported by libOSMesa: fetch it from the driver.
     using ClipControlFn = void (*)(GLenum, GLenum);
-    const auto clip_control = reinterpret_cast<ClipControlFn>(OSMesaGetProcAddress("glClipControl"));
+    const auto clip_control =
+        reinterpret_cast<ClipControlFn>(OSMesaGetProcAddress("glClipControl"));
     if (!clip_control) return Status::Error("OSMesa: glClipControl is not available");
     clip_control(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     const GLenum err = glGetError();
@@ -247,10 +257,11 @@ struct Renderer::Impl {
         const double corners[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};  // counter-clockwise
         for (const auto& c : corners) {
           const Eigen::Vector3d p = q.Point(c[0], c[1]);
-          vertices.insert(vertices.end(),
-                          {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()),
-                           static_cast<float>(c[0]), static_cast<float>(1.0 - c[1]),
-                           static_cast<float>(off_u + c[0] * lu), static_cast<float>(off_v + c[1] * lv)});
+          vertices.insert(
+              vertices.end(),
+              {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()),
+               static_cast<float>(c[0]), static_cast<float>(1.0 - c[1]),
+               static_cast<float>(off_u + c[0] * lu), static_cast<float>(off_v + c[1] * lv)});
         }
       }
     }
@@ -262,8 +273,10 @@ struct Renderer::Impl {
                  vertices.data(), GL_STATIC_DRAW);
     const GLsizei stride = 7 * sizeof(float);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(0));
-    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(3 * sizeof(float)));
-    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(5 * sizeof(float)));
+    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<void*>(3 * sizeof(float)));
+    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<void*>(5 * sizeof(float)));
     glEnableVertexAttribArray(0);
     glEnableVertexAttribArray(1);
     glEnableVertexAttribArray(2);
@@ -280,7 +293,8 @@ struct Renderer::Impl {
         return Status::Error("texture " + std::to_string(i) + " is not continuous BGR 8-bit");
       }
       glBindTexture(GL_TEXTURE_2D, textures[i]);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, img.cols, img.rows, 0, GL_BGR, GL_UNSIGNED_BYTE, img.data);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, img.cols, img.rows, 0, GL_BGR, GL_UNSIGNED_BYTE,
+                   img.data);
       glGenerateMipmap(GL_TEXTURE_2D);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -288,11 +302,13 @@ struct Renderer::Impl {
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
       glTexParameterf(GL_TEXTURE_2D, kMaxAnisotropy, static_cast<float>(options.anisotropy));
     }
-    for (auto& d : draws) d.texture = textures[static_cast<size_t>(scene->bodies[d.body].quads[d.quad].texture)];
+    for (auto& d : draws)
+      d.texture = textures[static_cast<size_t>(scene->bodies[d.body].quads[d.quad].texture)];
     const cv::Mat detail = MakeDetailTexture(1024, 7);
     glGenTextures(1, &detail_texture);
     glBindTexture(GL_TEXTURE_2D, detail_texture);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, detail.cols, detail.rows, 0, GL_RED, GL_UNSIGNED_BYTE, detail.data);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, detail.cols, detail.rows, 0, GL_RED, GL_UNSIGNED_BYTE,
+                 detail.data);
     glGenerateMipmap(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -336,7 +352,8 @@ struct Renderer::Impl {
     glGenRenderbuffers(1, &geometry_depth_rb);
     glBindRenderbuffer(GL_RENDERBUFFER, geometry_depth_rb);
     glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, geometry_depth_rb);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                              geometry_depth_rb);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
       return Status::Error("geometry framebuffer incomplete");
     }
@@ -405,7 +422,8 @@ struct Renderer::Impl {
       if (Culled(clip_from_body, q)) continue;
       if (!geometry) {
         const Eigen::Vector3d n = cam_from_body[d.body].rotation * q.Normal();
-        const double shade = scene->ambient + (1.0 - scene->ambient) * std::max(0.0, n.dot(light_in_cam));
+        const double shade =
+            scene->ambient + (1.0 - scene->ambient) * std::max(0.0, n.dot(light_in_cam));
         glUniform1f(p.shade, static_cast<float>(shade));
         glBindTexture(GL_TEXTURE_2D, d.texture);
       }
@@ -450,7 +468,8 @@ Status Renderer::RenderColor(const std::vector<Rigid3d>& cam_from_body, cv::Mat*
   if (!m.MakeCurrent()) return Status::Error("OSMesa: cannot make the context current");
   const int w = m.intrinsics.width, h = m.intrinsics.height;
   glBindFramebuffer(GL_FRAMEBUFFER, m.color_fbo);
-  const GLfloat sky[4] = {static_cast<GLfloat>(m.options.sky_bgr[2]), static_cast<GLfloat>(m.options.sky_bgr[1]),
+  const GLfloat sky[4] = {static_cast<GLfloat>(m.options.sky_bgr[2]),
+                          static_cast<GLfloat>(m.options.sky_bgr[1]),
                           static_cast<GLfloat>(m.options.sky_bgr[0]), 1.0f};
   glClearBufferfv(GL_COLOR, 0, sky);
   const GLfloat zero = 0.0f;
@@ -465,7 +484,8 @@ Status Renderer::RenderColor(const std::vector<Rigid3d>& cam_from_body, cv::Mat*
   cv::Mat bgra(h, w, CV_8UC4);
   glReadPixels(0, 0, w, h, GL_BGRA, GL_UNSIGNED_BYTE, bgra.data);
   const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) return Status::Error("GL error reading the colour image: " + std::to_string(err));
+  if (err != GL_NO_ERROR)
+    return Status::Error("GL error reading the colour image: " + std::to_string(err));
   cv::flip(bgra, bgra, 0);
   cv::cvtColor(bgra, *bgr, cv::COLOR_BGRA2BGR);
   return Status::Ok();
@@ -488,7 +508,8 @@ Status Renderer::RenderGeometry(const std::vector<Rigid3d>& cam_from_body, cv::M
   cv::Mat geom(h, w, CV_32FC4);
   glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, geom.data);
   const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) return Status::Error("GL error reading the geometry: " + std::to_string(err));
+  if (err != GL_NO_ERROR)
+    return Status::Error("GL error reading the geometry: " + std::to_string(err));
   body_id->create(h, w, CV_16UC1);
   points_in_cam->create(h, w, CV_32FC3);
   for (int r = 0; r < h; ++r) {

@@ -23,12 +23,14 @@ namespace mbslam {
 namespace sim {
 
 struct RendererOptions {
-  int antialias_samples = 4;       // multisampling of the colour image: 1 (off) or 4 (count)
-  double near_m = 0.05;            // near clipping distance (m); no far plane (reversed z)
-  double detail_strength = 0.25;   // contrast of the fine detail texture [0, 1]
-  double detail_period_m = 1.7;    // repetition period of the detail texture (m)
-  double anisotropy = 1.0;         // GL anisotropic texture filtering, 1 = off; very slow in llvmpipe (ratio)
-  int anisotropic_taps = 4;        // shader anisotropic filtering: taps along the footprint, 1 = off (count)
+  int antialias_samples = 4;      // multisampling of the colour image: 1 (off) or 4 (count)
+  double near_m = 0.05;           // near clipping distance (m); no far plane (reversed z)
+  double detail_strength = 0.25;  // contrast of the fine detail texture [0, 1]
+  double detail_period_m = 1.7;   // repetition period of the detail texture (m)
+  double anisotropy =
+      1.0;  // GL anisotropic texture filtering, 1 = off; very slow in llvmpipe (ratio)
+  int anisotropic_taps =
+      4;  // shader anisotropic filtering: taps along the footprint, 1 = off (count)
   std::array<double, 3> sky_bgr = {0.92, 0.80, 0.62};  // background colour, BGR [0, 1]
 
   bool Check() const {
@@ -44,11 +46,13 @@ struct RendererOptions {
   }
   template <typename V>
   void VisitFields(V& v) {
-    v("antialias_samples", &antialias_samples, "multisampling of the colour image: 1, 2 or 4 (count)");
+    v("antialias_samples", &antialias_samples,
+      "multisampling of the colour image: 1, 2 or 4 (count)");
     v("near_m", &near_m, "near clipping distance (m)");
     v("detail_strength", &detail_strength, "contrast of the fine detail texture [0, 1]");
     v("detail_period_m", &detail_period_m, "repetition period of the detail texture (m)");
-    v("anisotropy", &anisotropy, "GL anisotropic texture filtering, 1 = off; very slow in llvmpipe (ratio)");
+    v("anisotropy", &anisotropy,
+      "GL anisotropic texture filtering, 1 = off; very slow in llvmpipe (ratio)");
     v("anisotropic_taps", &anisotropic_taps, "shader anisotropic filtering taps, 1 = off (count)");
     v("sky_bgr", &sky_bgr, "background colour, BGR [0, 1]");
   }

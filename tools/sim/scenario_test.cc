@@ -47,8 +47,8 @@ Simulator* Get(const std::string& scenario, int width = 320) {
   return slot.get();
 }
 
-Eigen::Vector2d Project(const Simulator& sim, const Rigid3d& cam_from_world, const Eigen::Vector3d& p_world,
-                        double* depth = nullptr) {
+Eigen::Vector2d Project(const Simulator& sim, const Rigid3d& cam_from_world,
+                        const Eigen::Vector3d& p_world, double* depth = nullptr) {
   const Eigen::Vector3d p = cam_from_world * p_world;
   if (depth) *depth = p.z();
   return sim.intrinsics().Project(p);
@@ -56,8 +56,8 @@ Eigen::Vector2d Project(const Simulator& sim, const Rigid3d& cam_from_world, con
 
 TEST(Scenarios, AllRegistered) {
   const auto names = ScenarioNames();
-  for (const char* n : {"static", "crossing", "following", "previously_static", "multi", "robot_odometry",
-                        "rotation_only"}) {
+  for (const char* n : {"static", "crossing", "following", "previously_static", "multi",
+                        "robot_odometry", "rotation_only"}) {
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
     EXPECT_FALSE(ScenarioDescription(n).empty());
   }
@@ -69,8 +69,10 @@ TEST(Scenarios, EveryScenarioHasABuildFixture) {
   if (!bin) GTEST_SKIP() << "MBSLAM_BIN_DIR not set (run through ctest)";
   const std::string fixtures = std::string(bin) + "/../fixtures/sim/";
   for (const auto& name : ScenarioNames()) {
-    EXPECT_TRUE(std::ifstream(fixtures + name + "/timestamps.txt").good()) << "no fixture for " << name;
-    EXPECT_TRUE(std::ifstream(fixtures + name + "/sequence.lcmlog").good()) << "no fixture log for " << name;
+    EXPECT_TRUE(std::ifstream(fixtures + name + "/timestamps.txt").good())
+        << "no fixture for " << name;
+    EXPECT_TRUE(std::ifstream(fixtures + name + "/sequence.lcmlog").good())
+        << "no fixture log for " << name;
   }
 }
 
@@ -108,7 +110,8 @@ TEST(Scenarios, ObjectsDoNotFillTheFrame) {
       cv::minMaxLoc(f.depth, &min_depth, nullptr, nullptr, nullptr, f.depth > 0);
       EXPECT_GT(min_depth, 0.7) << name << " frame " << k;
       // Some sky at most: most of the image shows surfaces.
-      EXPECT_GT(cv::countNonZero(f.depth > 0), static_cast<int>(0.5 * f.depth.total())) << name << " " << k;
+      EXPECT_GT(cv::countNonZero(f.depth > 0), static_cast<int>(0.5 * f.depth.total()))
+          << name << " " << k;
     }
   }
 }
@@ -134,7 +137,8 @@ TEST(Scenarios, CrossingEntersLeavesAndOccludes) {
         double z;
         const Eigen::Vector2d uv = Project(*sim, cam_from_world, world_from_body * p, &z);
         if (z <= 0.1 || !sim->intrinsics().InImage(uv, 1.0)) continue;
-        const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
+        const int x = static_cast<int>(std::lround(uv.x())),
+                  y = static_cast<int>(std::lround(uv.y()));
         const int other = f.mask.at<uint16_t>(y, x);
         if (other > 0 && other != ids[i] && f.depth.at<float>(y, x) < z - 0.5) {
           occluded = true;
@@ -148,14 +152,16 @@ TEST(Scenarios, CrossingEntersLeavesAndOccludes) {
   int enter_and_leave = 0;
   for (const auto& v : visible) {
     const auto first = std::find(v.begin(), v.end(), true);
-    if (first == v.end() || first == v.begin()) continue;  // never visible or visible from the start
+    if (first == v.end() || first == v.begin())
+      continue;  // never visible or visible from the start
     const auto after = std::find(first, v.end(), false);
     if (after != v.end()) ++enter_and_leave;
   }
   EXPECT_GE(enter_and_leave, 1);
 }
 
-double EpipolarDistance(const Eigen::Matrix3d& F, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+double EpipolarDistance(const Eigen::Matrix3d& F, const Eigen::Vector2d& a,
+                        const Eigen::Vector2d& b) {
   const Eigen::Vector3d l = F * a.homogeneous();
   return std::abs(l.dot(b.homogeneous())) / l.head<2>().norm();
 }
@@ -187,7 +193,8 @@ EpipolarStats BodyEpipolar(const Simulator& sim, int id, int ka, int kb) {
   for (const auto& p : sim.SurfacePoints(id)) {
     double za, zb;
     const Eigen::Vector2d a = Project(sim, ca, wa * p, &za), b = Project(sim, cb, wb * p, &zb);
-    if (za < 0.5 || zb < 0.5 || !sim.intrinsics().InImage(a) || !sim.intrinsics().InImage(b)) continue;
+    if (za < 0.5 || zb < 0.5 || !sim.intrinsics().InImage(a) || !sim.intrinsics().InImage(b))
+      continue;
     ++s.points;
     s.max_distance = std::max(s.max_distance, EpipolarDistance(F, a, b));
     motion.push_back((b - a).norm());
@@ -220,7 +227,8 @@ TEST(Scenarios, FollowingIsDegenerate) {
   SimFrame f;
   for (int k = 0; k < sim->num_frames(); k += 50) {
     ASSERT_TRUE(sim->FrameTruth(k, &f).ok());
-    const Eigen::Vector3d in_cam = f.world_from_cam.Inverse() * f.bodies[0].world_from_body.translation;
+    const Eigen::Vector3d in_cam =
+        f.world_from_cam.Inverse() * f.bodies[0].world_from_body.translation;
     EXPECT_GT(in_cam.z(), 3.0);
     EXPECT_LT(std::abs(in_cam.x()), 0.2);
   }
@@ -289,8 +297,8 @@ TEST(Scenarios, RobotOdometryStream) {
   // world_from_cam(t) = world_from_odom * odom_from_base(t) * base_from_cam for one
   // fixed world_from_odom.
   const Rigid3d base_from_cam = *sim->base_from_cam();
-  const Rigid3d world_from_odom =
-      sim->WorldFromCam(truth.front().utime) * base_from_cam.Inverse() * truth.front().odom_from_base.Inverse();
+  const Rigid3d world_from_odom = sim->WorldFromCam(truth.front().utime) * base_from_cam.Inverse() *
+                                  truth.front().odom_from_base.Inverse();
   for (size_t i = 0; i < truth.size(); i += 25) {
     const Rigid3d predicted = world_from_odom * truth[i].odom_from_base * base_from_cam;
     const Rigid3d actual = sim->WorldFromCam(truth[i].utime);
@@ -306,7 +314,8 @@ TEST(Scenarios, RobotOdometryStream) {
     }
     return d;
   }();
-  const double drift = (odo.back().odom_from_base.translation - truth.back().odom_from_base.translation).norm();
+  const double drift =
+      (odo.back().odom_from_base.translation - truth.back().odom_from_base.translation).norm();
   EXPECT_GT(travelled, 5.0);
   EXPECT_GT(drift, 0.005);
   EXPECT_LT(drift, 0.1 * travelled);
@@ -332,8 +341,8 @@ TEST(Scenarios, TexturedAndTrackable) {
     EXPECT_GT(per_body[0], 300) << name;
     for (const auto& body : a.bodies) {
       if (body.pixel_count < 2000) continue;
-      EXPECT_GT(per_body[body.id], body.pixel_count / 250) << name << " body " << body.id << " ("
-                                                            << body.pixel_count << " px)";
+      EXPECT_GT(per_body[body.id], body.pixel_count / 250)
+          << name << " body " << body.id << " (" << body.pixel_count << " px)";
     }
 
     // KLT from frame k to k+1 against the true motion of each tracked surface point.
@@ -351,7 +360,8 @@ TEST(Scenarios, TexturedAndTrackable) {
       // Only interior points of one surface: all 3x3 neighbours on the same body.
       bool interior = a.depth.at<float>(y, x) > 0.0f;
       for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) interior = interior && a.mask.at<uint16_t>(y + dy, x + dx) == id;
+        for (int dx = -1; dx <= 1; ++dx)
+          interior = interior && a.mask.at<uint16_t>(y + dy, x + dx) == id;
       }
       if (!interior) continue;
       // The surface point under the feature (bilinear in the rendered points), moved with
@@ -360,8 +370,10 @@ TEST(Scenarios, TexturedAndTrackable) {
       cv::getRectSubPix(a.points_in_cam, cv::Size(1, 1), p0[i], patch, CV_32F);
       const cv::Vec3f q = patch.at<cv::Vec3f>(0, 0);
       const Eigen::Vector3d in_world = a.world_from_cam * Eigen::Vector3d(q[0], q[1], q[2]);
-      const Rigid3d b_from_a_body = sim->WorldFromBody(id, b.utime) * sim->WorldFromBody(id, a.utime).Inverse();
-      const Eigen::Vector2d expected = sim->intrinsics().Project(cam_b_from_world * (b_from_a_body * in_world));
+      const Rigid3d b_from_a_body =
+          sim->WorldFromBody(id, b.utime) * sim->WorldFromBody(id, a.utime).Inverse();
+      const Eigen::Vector2d expected =
+          sim->intrinsics().Project(cam_b_from_world * (b_from_a_body * in_world));
       if (!ok[i] || !sim->intrinsics().InImage(expected, 10.0)) continue;
       errors.push_back((expected - Eigen::Vector2d(p1[i].x, p1[i].y)).norm());
     }
@@ -369,7 +381,8 @@ TEST(Scenarios, TexturedAndTrackable) {
     std::sort(errors.begin(), errors.end());
     const double median = errors[errors.size() / 2];
     const double within_1px =
-        static_cast<double>(std::lower_bound(errors.begin(), errors.end(), 1.0) - errors.begin()) / errors.size();
+        static_cast<double>(std::lower_bound(errors.begin(), errors.end(), 1.0) - errors.begin()) /
+        errors.size();
     EXPECT_LT(median, 0.25) << name;
     EXPECT_GT(within_1px, 0.85) << name;
   }

@@ -82,33 +82,37 @@ MoverSpec EllipseMover(BodyClass c, const Eigen::Vector3d& extent, const Eigen::
 }
 
 struct HandheldSpec {
-  double height = 1.55;            // eye height (m)
-  double pitch_down = 0.08;        // mean downward pitch (rad)
-  double pitch_amplitude = 0.03;   // slow pitch oscillation (rad)
+  double height = 1.55;           // eye height (m)
+  double pitch_down = 0.08;       // mean downward pitch (rad)
+  double pitch_amplitude = 0.03;  // slow pitch oscillation (rad)
   double pitch_period_s = 5.0;
-  std::function<double(double)> look_yaw = [](double) { return 0.0; };  // relative to the path heading (rad)
-  double shake_rotation_rms = 0.004;  // hand tremor (rad)
+  std::function<double(double)> look_yaw = [](double) {
+    return 0.0;
+  };                                     // relative to the path heading (rad)
+  double shake_rotation_rms = 0.004;     // hand tremor (rad)
   double shake_translation_rms = 0.006;  // (m)
-  double bob_amplitude = 0.015;    // walking bob at 2 Hz (m)
+  double bob_amplitude = 0.015;          // walking bob at 2 Hz (m)
 };
 
 // world_from_cam of a hand-held camera carried along `head(t)` = (x, y, yaw, speed).
-PoseTrack HandheldCamera(const std::function<PlanarPath::State(double)>& head, const HandheldSpec& spec,
-                         const Timeline& tl, uint64_t seed) {
+PoseTrack HandheldCamera(const std::function<PlanarPath::State(double)>& head,
+                         const HandheldSpec& spec, const Timeline& tl, uint64_t seed) {
   const SmoothNoise3 tremor(seed * 3 + 1, spec.shake_rotation_rms, 0.5, 4.0);
   const SmoothNoise3 sway(seed * 3 + 2, spec.shake_translation_rms, 0.6, 3.0);
   return PoseTrack::Sample(
       [&](int64_t utime) {
         const double t = tl.Seconds(utime);
         const PlanarPath::State s = head(t);
-        const double bob = spec.bob_amplitude * std::min(1.0, s.speed) * std::sin(2.0 * M_PI * 2.0 * t);
+        const double bob =
+            spec.bob_amplitude * std::min(1.0, s.speed) * std::sin(2.0 * M_PI * 2.0 * t);
         const Eigen::Vector3d offset = sway.At(t) + Eigen::Vector3d(0.0, 0.0, bob);
-        const Rigid3d world_from_head =
-            PlanarPose(s.x + offset.x(), s.y + offset.y(), spec.height + offset.z(), s.yaw + spec.look_yaw(t));
+        const Rigid3d world_from_head = PlanarPose(
+            s.x + offset.x(), s.y + offset.y(), spec.height + offset.z(), s.yaw + spec.look_yaw(t));
         const double pitch =
             spec.pitch_down + spec.pitch_amplitude * std::sin(2.0 * M_PI * t / spec.pitch_period_s);
-        const Rigid3d head_from_cam = ForwardCameraMount(Eigen::Vector3d::Zero(), pitch) *
-                                      Rigid3d(Eigen::Matrix3d(ExpSO3(tremor.At(t))), Eigen::Vector3d::Zero());
+        const Rigid3d head_from_cam =
+            ForwardCameraMount(Eigen::Vector3d::Zero(), pitch) *
+            Rigid3d(Eigen::Matrix3d(ExpSO3(tremor.At(t))), Eigen::Vector3d::Zero());
         return world_from_head * head_from_cam;
       },
       tl.begin, tl.stop);
@@ -157,14 +161,16 @@ ScenarioPlan CrossingPlan(const Timeline& tl, uint64_t seed) {
   spec.look_yaw = [](double t) { return 0.12 * std::sin(2.0 * M_PI * t / 9.0); };
   plan.camera = HandheldCamera([&](double t) { return path.At(t); }, spec, tl, seed);
   const double d = tl.duration_s + 2.0;
-  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, PlanarPath(20.0, 22.0, -M_PI / 2, 7.0).Drive(d), tl,
+  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent,
+                                  PlanarPath(20.0, 22.0, -M_PI / 2, 7.0).Drive(d), tl,
                                   cv::Scalar(0.15, 0.2, 0.75)));
-  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, PlanarPath(24.0, -30.0, M_PI / 2, 5.0).Drive(d), tl,
+  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent,
+                                  PlanarPath(24.0, -30.0, M_PI / 2, 5.0).Drive(d), tl,
                                   cv::Scalar(0.7, 0.45, 0.15)));
-  plan.movers.push_back(
-      PathMover(BodyClass::kPerson, kPersonExtent, PlanarPath(9.0, -7.0, M_PI / 2, 1.3).Drive(d), tl));
-  plan.movers.push_back(
-      PathMover(BodyClass::kPerson, kPersonExtent, PlanarPath(11.5, 6.0, -M_PI / 2, 1.1).Drive(d), tl));
+  plan.movers.push_back(PathMover(BodyClass::kPerson, kPersonExtent,
+                                  PlanarPath(9.0, -7.0, M_PI / 2, 1.3).Drive(d), tl));
+  plan.movers.push_back(PathMover(BodyClass::kPerson, kPersonExtent,
+                                  PlanarPath(11.5, 6.0, -M_PI / 2, 1.1).Drive(d), tl));
   plan.movers.push_back(PathMover(BodyClass::kRobot, kRobotExtent,
                                   PlanarPath(14.0, -4.0, M_PI / 2, 0.8).Drive(d, 0.0, -0.1), tl,
                                   cv::Scalar(0.8, 0.8, 0.8)));
@@ -184,15 +190,18 @@ ScenarioPlan FollowingPlan(const Timeline& tl, uint64_t seed) {
   plan.camera = PoseTrack::Sample(
       [&](int64_t utime) {
         return base.WorldFromBody(utime) * plan.base_from_cam *
-               Rigid3d(Eigen::Matrix3d(ExpSO3(vibration.At(tl.Seconds(utime)))), Eigen::Vector3d::Zero());
+               Rigid3d(Eigen::Matrix3d(ExpSO3(vibration.At(tl.Seconds(utime)))),
+                       Eigen::Vector3d::Zero());
       },
       tl.begin, tl.stop);
   PlanarPath leader(5.5, 0.0, 0.0, 1.2);
   leader.RampTo(1.5, 3.0).RampTo(1.0, 4.0).RampTo(1.3, 3.0).Drive(std::max(0.0, d - 10.0));
   plan.movers.push_back(PathMover(BodyClass::kPerson, kPersonExtent, leader, tl));
-  plan.movers.push_back(PathMover(BodyClass::kRobot, kRobotExtent, PlanarPath(6.0, -2.5, 0.0, 1.0).Drive(d), tl,
+  plan.movers.push_back(PathMover(BodyClass::kRobot, kRobotExtent,
+                                  PlanarPath(6.0, -2.5, 0.0, 1.0).Drive(d), tl,
                                   cv::Scalar(0.2, 0.6, 0.9)));
-  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, PlanarPath(-8.0, 4.0, 0.0, 3.0).Drive(d), tl,
+  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent,
+                                  PlanarPath(-8.0, 4.0, 0.0, 3.0).Drive(d), tl,
                                   cv::Scalar(0.75, 0.75, 0.72)));
   return plan;
 }
@@ -211,7 +220,8 @@ ScenarioPlan PreviouslyStaticPlan(const Timeline& tl, uint64_t seed) {
   car.Wait(car_start).RampTo(2.0, 2.5).Drive(d);
   PlanarPath person(5.0, 6.0, 0.0, 0.0);
   person.Wait(person_start).RampTo(1.2, 1.0).Drive(d);
-  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, car, tl, cv::Scalar(0.2, 0.55, 0.2)));
+  plan.movers.push_back(
+      PathMover(BodyClass::kCar, kCarExtent, car, tl, cv::Scalar(0.2, 0.55, 0.2)));
   plan.movers.push_back(PathMover(BodyClass::kPerson, kPersonExtent, person, tl));
   return plan;
 }
@@ -232,13 +242,16 @@ ScenarioPlan MultiPlan(const Timeline& tl, uint64_t seed) {
     return s;
   };
   plan.camera = HandheldCamera(head, spec, tl, seed);
-  plan.movers.push_back(EllipseMover(BodyClass::kCar, kCarExtent, {7.8, -1.5}, 1.5, 3.5, 2.5, 0.0, 1, tl,
-                                     cv::Scalar(0.1, 0.1, 0.7)));
-  plan.movers.push_back(EllipseMover(BodyClass::kCar, kCarExtent, {13.5, 2.5}, 1.5, 4.0, 3.0, 1.0, -1, tl,
-                                     cv::Scalar(0.75, 0.6, 0.2)));
-  plan.movers.push_back(EllipseMover(BodyClass::kPerson, kPersonExtent, {3.6, 1.45}, 0.8, 0.8, 1.1, 0.5, 1, tl));
-  plan.movers.push_back(EllipseMover(BodyClass::kPerson, kPersonExtent, {4.2, -1.6}, 0.3, 1.3, 1.0, 2.0, -1, tl));
-  plan.movers.push_back(EllipseMover(BodyClass::kPerson, kPersonExtent, {2.5, -0.4}, 0.45, 0.45, 0.8, 4.0, 1, tl));
+  plan.movers.push_back(EllipseMover(BodyClass::kCar, kCarExtent, {7.8, -1.5}, 1.5, 3.5, 2.5, 0.0,
+                                     1, tl, cv::Scalar(0.1, 0.1, 0.7)));
+  plan.movers.push_back(EllipseMover(BodyClass::kCar, kCarExtent, {13.5, 2.5}, 1.5, 4.0, 3.0, 1.0,
+                                     -1, tl, cv::Scalar(0.75, 0.6, 0.2)));
+  plan.movers.push_back(
+      EllipseMover(BodyClass::kPerson, kPersonExtent, {3.6, 1.45}, 0.8, 0.8, 1.1, 0.5, 1, tl));
+  plan.movers.push_back(
+      EllipseMover(BodyClass::kPerson, kPersonExtent, {4.2, -1.6}, 0.3, 1.3, 1.0, 2.0, -1, tl));
+  plan.movers.push_back(
+      EllipseMover(BodyClass::kPerson, kPersonExtent, {2.5, -0.4}, 0.45, 0.45, 0.8, 4.0, 1, tl));
   plan.clutter_per_m2 = 1.0 / 120.0;
   return plan;
 }
@@ -251,12 +264,14 @@ ScenarioPlan RobotOdometryPlan(const Timeline& tl, uint64_t seed) {
   plan.base = RobotBase(path, tl, seed, 0.003, 0.002);
   plan.base_from_cam = ForwardCameraMount(Eigen::Vector3d(0.25, 0.0, 0.55), 0.1);
   plan.camera = CameraOnBase(*plan.base, plan.base_from_cam, tl);
-  plan.movers.push_back(
-      PathMover(BodyClass::kPerson, kPersonExtent, PlanarPath(12.0, -5.6, M_PI / 2, 1.2).Drive(d), tl));
-  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, PlanarPath(20.0, -25.0, M_PI / 2, 6.0).Drive(d), tl,
+  plan.movers.push_back(PathMover(BodyClass::kPerson, kPersonExtent,
+                                  PlanarPath(12.0, -5.6, M_PI / 2, 1.2).Drive(d), tl));
+  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent,
+                                  PlanarPath(20.0, -25.0, M_PI / 2, 6.0).Drive(d), tl,
                                   cv::Scalar(0.6, 0.2, 0.5)));
-  plan.movers.push_back(PathMover(BodyClass::kRobot, kRobotExtent, PlanarPath(11.0, 12.0, -M_PI / 2, 0.5).Drive(d),
-                                  tl, cv::Scalar(0.3, 0.8, 0.8)));
+  plan.movers.push_back(PathMover(BodyClass::kRobot, kRobotExtent,
+                                  PlanarPath(11.0, 12.0, -M_PI / 2, 0.5).Drive(d), tl,
+                                  cv::Scalar(0.3, 0.8, 0.8)));
   return plan;
 }
 
@@ -273,9 +288,10 @@ ScenarioPlan RotationOnlyPlan(const Timeline& tl, uint64_t seed) {
       },
       tl.begin, tl.stop);
   const double d = tl.duration_s + 2.0;
-  plan.movers.push_back(
-      PathMover(BodyClass::kPerson, kPersonExtent, PlanarPath(7.0, 4.0, -M_PI / 2, 1.0).Drive(d), tl));
-  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, PlanarPath(16.0, -30.0, M_PI / 2, 5.0).Drive(d), tl,
+  plan.movers.push_back(PathMover(BodyClass::kPerson, kPersonExtent,
+                                  PlanarPath(7.0, 4.0, -M_PI / 2, 1.0).Drive(d), tl));
+  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent,
+                                  PlanarPath(16.0, -30.0, M_PI / 2, 5.0).Drive(d), tl,
                                   cv::Scalar(0.3, 0.3, 0.3)));
   return plan;
 }
@@ -293,11 +309,13 @@ ScenarioPlan DrivingPlan(const Timeline& tl, uint64_t seed) {
   // Its lane follows the camera's path; the oncoming lane is 3.5 m to the left.
   PlanarPath ahead(18.0, 0.0, 0.0, 5.5);
   ahead.Drive(3.0).Drive(4.0, 0.0, 0.03).Drive(d, 0.0, -0.02);
-  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, ahead, tl, cv::Scalar(0.2, 0.2, 0.6)));
-  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent, PlanarPath(75.0, 5.5, M_PI, 8.0).Drive(d), tl,
-                                  cv::Scalar(0.7, 0.7, 0.7)));
   plan.movers.push_back(
-      PathMover(BodyClass::kPerson, kPersonExtent, PlanarPath(40.0, -9.0, M_PI / 2, 1.4).Drive(d), tl));
+      PathMover(BodyClass::kCar, kCarExtent, ahead, tl, cv::Scalar(0.2, 0.2, 0.6)));
+  plan.movers.push_back(PathMover(BodyClass::kCar, kCarExtent,
+                                  PlanarPath(75.0, 5.5, M_PI, 8.0).Drive(d), tl,
+                                  cv::Scalar(0.7, 0.7, 0.7)));
+  plan.movers.push_back(PathMover(BodyClass::kPerson, kPersonExtent,
+                                  PlanarPath(40.0, -9.0, M_PI / 2, 1.4).Drive(d), tl));
   plan.movers.push_back(
       PathMover(BodyClass::kPerson, kPersonExtent, PlanarPath(25.0, 8.5, 0.0, 1.2).Drive(d), tl));
   plan.building_margin_m = 12.0;
@@ -316,17 +334,22 @@ const std::vector<ScenarioEntry>& Registry() {
   static const std::vector<ScenarioEntry> entries = {
       {"static", StaticPlan, "hand-held walk through a static town square, no movers"},
       {"crossing", CrossingPlan,
-       "hand-held walk; 2 cars, 2 people and a robot cross, enter / leave the view, occlude each other"},
+       "hand-held walk; 2 cars, 2 people and a robot cross, enter / leave the view, occlude each "
+       "other"},
       {"following", FollowingPlan,
-       "robot camera follows a walking person on the same line (degenerate: motion in the epipolar plane)"},
+       "robot camera follows a walking person on the same line (degenerate: motion in the epipolar "
+       "plane)"},
       {"previously_static", PreviouslyStaticPlan,
        "hand-held sideways walk; a parked car and a standing person start moving part-way"},
-      {"multi", MultiPlan, "5 movers (2 cars, 3 people) near a slowly moving hand-held camera, >= 25 % of the image"},
+      {"multi", MultiPlan,
+       "5 movers (2 cars, 3 people) near a slowly moving hand-held camera, >= 25 % of the image"},
       {"robot_odometry", RobotOdometryPlan,
        "camera on a ground robot with noisy 50 Hz wheel odometry and extrinsic base_from_cam"},
-      {"rotation_only", RotationOnlyPlan, "camera rotating about its centre (no translation); a person and a car move"},
+      {"rotation_only", RotationOnlyPlan,
+       "camera rotating about its centre (no translation); a person and a car move"},
       {"driving", DrivingPlan,
-       "car-mounted camera at 6 m/s down a street: a car ahead, an oncoming car, a crossing and a walking person"},
+       "car-mounted camera at 6 m/s down a street: a car ahead, an oncoming car, a crossing and a "
+       "walking person"},
   };
   return entries;
 }
@@ -360,15 +383,17 @@ bool Intersects(const Eigen::AlignedBox2d& rect, const std::vector<Corridor>& co
 class Rng {
  public:
   explicit Rng(uint64_t seed) : engine_(seed) {}
-  double Uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(engine_); }
+  double Uniform(double a, double b) {
+    return std::uniform_real_distribution<double>(a, b)(engine_);
+  }
   bool Chance(double p) { return Uniform(0.0, 1.0) < p; }
 
  private:
   std::mt19937_64 engine_;
 };
 
-void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder* builder, SceneBody* world,
-                      Rng* rng) {
+void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder* builder,
+                      SceneBody* world, Rng* rng) {
   // The action area: the camera path, with the building rows `building_margin_m` away.
   Eigen::AlignedBox2d area;
   for (int64_t t = tl.start; t <= tl.end + 100000; t += 100000) {
@@ -393,7 +418,9 @@ void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder
   for (double x = gx0; x < gx1; x += tile) {
     for (double y = gy0; y < gy1; y += tile) {
       const double r = rng->Uniform(0.0, 1.0);
-      const TextureStyle style = r < 0.45 ? TextureStyle::kAsphalt : (r < 0.85 ? TextureStyle::kPaving : TextureStyle::kGrass);
+      const TextureStyle style = r < 0.45
+                                     ? TextureStyle::kAsphalt
+                                     : (r < 0.85 ? TextureStyle::kPaving : TextureStyle::kGrass);
       builder->AddGroundTile(world, x, y, x + tile, y + tile, style);
     }
   }
@@ -408,7 +435,8 @@ void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder
         const Eigen::Vector2d c = footprint.center();
         const Eigen::Vector2d size = footprint.sizes();
         builder->AddBox(world, identity, Eigen::Vector3d(c.x(), c.y(), 0.5 * height),
-                        Eigen::Vector3d(size.x(), size.y(), height), 0.0, TextureStyle::kFacade, false);
+                        Eigen::Vector3d(size.x(), size.y(), height), 0.0, TextureStyle::kFacade,
+                        false);
         return;
       }
       footprint.translate(6.0 * outward);
@@ -452,7 +480,8 @@ void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder
     TextureStyle style = TextureStyle::kConcrete;
     cv::Scalar tint(-1, -1, -1);
     if (kind < 0.25) {
-      size = Eigen::Vector3d(rng->Uniform(0.5, 1.2), rng->Uniform(0.5, 1.2), rng->Uniform(0.4, 1.1));
+      size =
+          Eigen::Vector3d(rng->Uniform(0.5, 1.2), rng->Uniform(0.5, 1.2), rng->Uniform(0.4, 1.1));
       style = TextureStyle::kCrate;
     } else if (kind < 0.4) {
       size = Eigen::Vector3d(0.6, 0.6, rng->Uniform(0.8, 1.2));
@@ -463,7 +492,8 @@ void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder
       const double w = rng->Uniform(0.25, 0.45);
       size = Eigen::Vector3d(w, w, rng->Uniform(2.5, 4.0));
     } else if (kind < 0.72) {
-      size = Eigen::Vector3d(rng->Uniform(2.0, 3.0), rng->Uniform(1.8, 2.5), rng->Uniform(2.3, 2.8));
+      size =
+          Eigen::Vector3d(rng->Uniform(2.0, 3.0), rng->Uniform(1.8, 2.5), rng->Uniform(2.3, 2.8));
       style = TextureStyle::kFacade;
     } else if (kind < 0.86) {
       size = Eigen::Vector3d(rng->Uniform(3.0, 6.0), 0.3, rng->Uniform(0.7, 1.2));
@@ -472,9 +502,11 @@ void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder
       style = TextureStyle::kVehicle;
     }
     const double yaw = rng->Uniform(0.0, M_PI);
-    const Eigen::Vector2d c(rng->Uniform(area.min().x(), area.max().x()), rng->Uniform(area.min().y(), area.max().y()));
+    const Eigen::Vector2d c(rng->Uniform(area.min().x(), area.max().x()),
+                            rng->Uniform(area.min().y(), area.max().y()));
     const double r = 0.5 * std::hypot(size.x(), size.y());
-    const Eigen::AlignedBox2d bound(c - Eigen::Vector2d::Constant(r), c + Eigen::Vector2d::Constant(r));
+    const Eigen::AlignedBox2d bound(c - Eigen::Vector2d::Constant(r),
+                                    c + Eigen::Vector2d::Constant(r));
     if (Intersects(bound, clutter_keep_out)) continue;
     bool overlaps = false;
     for (const auto& p : placed) {
@@ -482,17 +514,23 @@ void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder
     }
     if (overlaps) continue;
     placed.push_back(bound);
-    builder->AddBox(world, identity, Eigen::Vector3d(c.x(), c.y(), 0.5 * size.z()), size, yaw, style, false, tint);
+    builder->AddBox(world, identity, Eigen::Vector3d(c.x(), c.y(), 0.5 * size.z()), size, yaw,
+                    style, false, tint);
   }
 }
 
 TextureStyle StyleFor(BodyClass c) {
   switch (c) {
-    case BodyClass::kCar: return TextureStyle::kVehicle;
-    case BodyClass::kPerson: return TextureStyle::kClothing;
-    case BodyClass::kRobot: return TextureStyle::kVehicle;
-    case BodyClass::kBox: return TextureStyle::kCrate;
-    case BodyClass::kStatic: return TextureStyle::kConcrete;
+    case BodyClass::kCar:
+      return TextureStyle::kVehicle;
+    case BodyClass::kPerson:
+      return TextureStyle::kClothing;
+    case BodyClass::kRobot:
+      return TextureStyle::kVehicle;
+    case BodyClass::kBox:
+      return TextureStyle::kCrate;
+    case BodyClass::kStatic:
+      return TextureStyle::kConcrete;
   }
   return TextureStyle::kConcrete;
 }
@@ -542,8 +580,9 @@ Status BuildScenario(const SimOptions& options, Scene* scene) {
     camera_positions.push_back(plan.camera.WorldFromBody(t).translation);
   }
   const double fx = options.camera.Intrinsics().fx;
-  SceneBuilder builder(scene, camera_positions, options.texel_m * 525.0 / fx, options.lod_distance_m,
-                       options.max_texture_px, seed * 0x2545F4914F6CDD1DULL + 17);
+  SceneBuilder builder(scene, camera_positions, options.texel_m * 525.0 / fx,
+                       options.lod_distance_m, options.max_texture_px,
+                       seed * 0x2545F4914F6CDD1DULL + 17);
   Rng rng(seed * 0x9E3779B97F4A7C15ULL + 3);
 
   SceneBody world;
@@ -562,11 +601,12 @@ Status BuildScenario(const SimOptions& options, Scene* scene) {
     body.name = BodyClassName(m.body_class);
     body.extent = m.extent;
     body.track = std::move(m.track);
-    builder.AddBox(&body, body.track.WorldFromBody(tl.start), Eigen::Vector3d::Zero(), m.extent, 0.0,
-                   StyleFor(m.body_class), false, m.tint);
+    builder.AddBox(&body, body.track.WorldFromBody(tl.start), Eigen::Vector3d::Zero(), m.extent,
+                   0.0, StyleFor(m.body_class), false, m.tint);
     scene->bodies.push_back(std::move(body));
   }
-  builder.GenerateTextures(static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 4u)));
+  builder.GenerateTextures(
+      static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 4u)));
   size_t texture_bytes = 0;
   for (const auto& t : scene->textures) texture_bytes += t.total() * t.elemSize();
   MBSLAM_LOG(DEBUG) << "scenario " << scene->scenario << ": " << scene->bodies.size() << " bodies, "

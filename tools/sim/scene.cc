@@ -12,11 +12,16 @@ namespace sim {
 
 const char* BodyClassName(BodyClass c) {
   switch (c) {
-    case BodyClass::kStatic: return "static";
-    case BodyClass::kCar: return "car";
-    case BodyClass::kPerson: return "person";
-    case BodyClass::kBox: return "box";
-    case BodyClass::kRobot: return "robot";
+    case BodyClass::kStatic:
+      return "static";
+    case BodyClass::kCar:
+      return "car";
+    case BodyClass::kPerson:
+      return "person";
+    case BodyClass::kBox:
+      return "box";
+    case BodyClass::kRobot:
+      return "robot";
   }
   return "unknown";
 }
@@ -106,7 +111,8 @@ void SceneBuilder::GenerateTextures(int threads) {
   auto work = [&]() {
     for (size_t i = next++; i < jobs_.size(); i = next++) {
       const TextureJob& j = jobs_[i];
-      scene_->textures[first + i] = MakeTexture(j.style, j.width, j.height, j.texel_m, j.seed, j.tint);
+      scene_->textures[first + i] =
+          MakeTexture(j.style, j.width, j.height, j.texel_m, j.seed, j.tint);
     }
   };
   std::vector<std::thread> pool;
@@ -128,11 +134,11 @@ void SceneBuilder::AddBox(SceneBody* body, const Rigid3d& world_from_body,
     Eigen::Vector3d o, u, v;
   };
   std::vector<Face> faces = {
-      {{a, -b, -c}, {0, 2 * b, 0}, {0, 0, 2 * c}},    // +x
-      {{-a, b, -c}, {0, -2 * b, 0}, {0, 0, 2 * c}},   // -x
-      {{a, b, -c}, {-2 * a, 0, 0}, {0, 0, 2 * c}},    // +y
-      {{-a, -b, -c}, {2 * a, 0, 0}, {0, 0, 2 * c}},   // -y
-      {{-a, -b, c}, {2 * a, 0, 0}, {0, 2 * b, 0}},    // +z
+      {{a, -b, -c}, {0, 2 * b, 0}, {0, 0, 2 * c}},   // +x
+      {{-a, b, -c}, {0, -2 * b, 0}, {0, 0, 2 * c}},  // -x
+      {{a, b, -c}, {-2 * a, 0, 0}, {0, 0, 2 * c}},   // +y
+      {{-a, -b, -c}, {2 * a, 0, 0}, {0, 0, 2 * c}},  // -y
+      {{-a, -b, c}, {2 * a, 0, 0}, {0, 2 * b, 0}},   // +z
   };
   if (with_bottom) faces.push_back({{-a, b, -c}, {2 * a, 0, 0}, {0, -2 * b, 0}});  // -z
   for (const Face& f : faces) {
@@ -169,7 +175,8 @@ bool IntersectQuad(const Quad& q, const Eigen::Vector3d& o, const Eigen::Vector3
   if (dist <= 0.0) return false;
   const Eigen::Vector3d p = o + dist * d - q.origin;
   // Solve p = s u + t v in the least-squares sense (exact for points in the plane).
-  const double uu = q.edge_u.dot(q.edge_u), uv = q.edge_u.dot(q.edge_v), vv = q.edge_v.dot(q.edge_v);
+  const double uu = q.edge_u.dot(q.edge_u), uv = q.edge_u.dot(q.edge_v),
+               vv = q.edge_v.dot(q.edge_v);
   const double pu = p.dot(q.edge_u), pv = p.dot(q.edge_v);
   const double det = uu * vv - uv * uv;
   const double s = (pu * vv - pv * uv) / det;
@@ -181,7 +188,8 @@ bool IntersectQuad(const Quad& q, const Eigen::Vector3d& o, const Eigen::Vector3
   return true;
 }
 
-bool RayHitsBox(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+bool RayHitsBox(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& o,
+                const Eigen::Vector3d& d) {
   double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
   for (int i = 0; i < 3; ++i) {
     const double lo = box.min()[i] - 1e-9, hi = box.max()[i] + 1e-9;
@@ -240,15 +248,17 @@ std::vector<Eigen::Vector3d> SampleSurfacePoints(const SceneBody& body, double p
   }
   std::vector<Eigen::Vector3d> points;
   if (body.quads.empty() || total <= 0.0) return points;
-  const int n = std::clamp(static_cast<int>(std::lround(points_per_m2 * total)), min_points, max_points);
+  const int n =
+      std::clamp(static_cast<int>(std::lround(points_per_m2 * total)), min_points, max_points);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   points.reserve(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) {
     const double r = u(rng) * total;
-    const size_t k = std::min(static_cast<size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), r) -
-                                                  cumulative.begin()),
-                              body.quads.size() - 1);
+    const size_t k =
+        std::min(static_cast<size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), r) -
+                                     cumulative.begin()),
+                 body.quads.size() - 1);
     points.push_back(body.quads[k].Point(u(rng), u(rng)));
   }
   return points;

@@ -29,10 +29,10 @@ namespace sim {
 // t * edge_v for s, t in [0, 1]. Its front side faces along edge_u x edge_v (only the
 // front side is drawn). The texture covers it once, texture row 0 at t = 1.
 struct Quad {
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // corner (m, body frame)
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();   // corner (m, body frame)
   Eigen::Vector3d edge_u = Eigen::Vector3d::UnitX();  // first edge (m)
   Eigen::Vector3d edge_v = Eigen::Vector3d::UnitY();  // second edge (m)
-  int texture = -1;                                  // index into Scene::textures
+  int texture = -1;                                   // index into Scene::textures
   double sample_weight = 1.0;  // relative density of ground-truth surface samples (0 = never seen)
 
   Eigen::Vector3d Normal() const { return edge_u.cross(edge_v).normalized(); }
@@ -44,24 +44,26 @@ enum class BodyClass { kStatic, kCar, kPerson, kBox, kRobot };
 const char* BodyClassName(BodyClass c);
 
 struct SceneBody {
-  int id = 0;                                   // mask value; 0 = static world
-  std::string name;                             // "static", "car", "person", "box", "robot"
+  int id = 0;        // mask value; 0 = static world
+  std::string name;  // "static", "car", "person", "box", "robot"
   BodyClass body_class = BodyClass::kStatic;
-  Eigen::Vector3d extent = Eigen::Vector3d::Zero();  // full box size along body x, y, z (m); 0 for static
+  Eigen::Vector3d extent =
+      Eigen::Vector3d::Zero();  // full box size along body x, y, z (m); 0 for static
   std::vector<Quad> quads;
-  PoseTrack track;                              // world_from_body over time
+  PoseTrack track;  // world_from_body over time
 };
 
 struct Scene {
   std::string scenario;
-  std::vector<SceneBody> bodies;   // bodies[0] is the static world (id 0), then ids 1..N
-  std::vector<cv::Mat> textures;   // BGR 8-bit
-  PoseTrack camera;                // world_from_cam
+  std::vector<SceneBody> bodies;  // bodies[0] is the static world (id 0), then ids 1..N
+  std::vector<cv::Mat> textures;  // BGR 8-bit
+  PoseTrack camera;               // world_from_cam
   // Robot carrying the camera (robot_odometry): world_from_base and base_from_cam.
   std::optional<PoseTrack> base;
   Rigid3d base_from_cam;
-  Eigen::Vector3d light_direction = Eigen::Vector3d(0.4, 0.25, 0.88).normalized();  // towards the sun, world
-  double ambient = 0.45;           // fraction of light that is not directional [0, 1]
+  Eigen::Vector3d light_direction =
+      Eigen::Vector3d(0.4, 0.25, 0.88).normalized();  // towards the sun, world
+  double ambient = 0.45;  // fraction of light that is not directional [0, 1]
 
   // Index into `bodies` of the body with this id, or -1.
   int BodyIndex(int id) const;
@@ -83,11 +85,13 @@ class SceneBuilder {
   // For the static world (body id 0), world_from_body gives the level of detail, and
   // faces never seen from the camera path get a token texture; moving bodies always get
   // the full resolution. `texel_factor` scales the texel size.
-  void AddBox(SceneBody* body, const Rigid3d& world_from_body, const Eigen::Vector3d& center_in_body,
-              const Eigen::Vector3d& size, double yaw, TextureStyle style, bool with_bottom,
-              const cv::Scalar& tint = cv::Scalar(-1, -1, -1), double texel_factor = 1.0);
+  void AddBox(SceneBody* body, const Rigid3d& world_from_body,
+              const Eigen::Vector3d& center_in_body, const Eigen::Vector3d& size, double yaw,
+              TextureStyle style, bool with_bottom, const cv::Scalar& tint = cv::Scalar(-1, -1, -1),
+              double texel_factor = 1.0);
   // A horizontal ground rectangle at z = 0 (static body).
-  void AddGroundTile(SceneBody* body, double x0, double y0, double x1, double y1, TextureStyle style);
+  void AddGroundTile(SceneBody* body, double x0, double y0, double x1, double y1,
+                     TextureStyle style);
 
   uint64_t NextSeed();
 
@@ -104,8 +108,8 @@ class SceneBuilder {
     uint64_t seed;
     cv::Scalar tint;
   };
-  int AddTexture(const Quad& quad, const Rigid3d& world_from_body, bool is_static, TextureStyle style,
-                 const cv::Scalar& tint, double texel_factor);
+  int AddTexture(const Quad& quad, const Rigid3d& world_from_body, bool is_static,
+                 TextureStyle style, const cv::Scalar& tint, double texel_factor);
   double DistanceToCamera(const Eigen::Vector3d& point) const;
 
   Scene* scene_;
@@ -114,15 +118,15 @@ class SceneBuilder {
   double lod_distance_m_;
   int max_texture_px_;
   uint64_t seed_;
-  double sample_weight_ = 1.0;  // of the quad whose texture was made last
+  double sample_weight_ = 1.0;    // of the quad whose texture was made last
   std::vector<TextureJob> jobs_;  // textures to generate (the last jobs_.size() of the scene's)
 };
 
 // Result of casting a ray into the scene.
 struct RayHit {
-  int body_index = -1;     // index into Scene::bodies, -1 if nothing was hit
+  int body_index = -1;  // index into Scene::bodies, -1 if nothing was hit
   int quad_index = -1;
-  double distance = 0.0;   // along the (unit) ray direction (m)
+  double distance = 0.0;  // along the (unit) ray direction (m)
   Eigen::Vector3d point_in_body = Eigen::Vector3d::Zero();
   double edge_distance = 0.0;  // distance of the hit from the quad's border (m)
 };

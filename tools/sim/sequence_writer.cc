@@ -136,7 +136,8 @@ mbslam::odometry_t MakeOdometryMessage(const OdometrySample& o) {
   return msg;
 }
 
-Status WriteImage(const std::string& path, const cv::Mat& img, const std::vector<int>& params = {}) {
+Status WriteImage(const std::string& path, const cv::Mat& img,
+                  const std::vector<int>& params = {}) {
   try {
     if (!cv::imwrite(path, img, params)) return Status::Error("cannot write " + path);
   } catch (const cv::Exception& e) {
@@ -153,8 +154,8 @@ std::string Vec3Yaml(const Eigen::Vector3d& v) {
 }
 
 // Writes images/, masks/, depth/ of frame k.
-Status WriteFrameFiles(const fs::path& root, const SequenceWriterOptions& options, int k, const cv::Mat& image,
-                       const cv::Mat& mask, const cv::Mat& depth) {
+Status WriteFrameFiles(const fs::path& root, const SequenceWriterOptions& options, int k,
+                       const cv::Mat& image, const cv::Mat& mask, const cv::Mat& depth) {
   MBSLAM_RETURN_IF_ERROR(WriteImage((root / "images" / FrameName(k, "png")).string(), image));
   if (options.write_masks) {
     MBSLAM_RETURN_IF_ERROR(WriteImage((root / "masks" / FrameName(k, "png")).string(), mask));
@@ -165,7 +166,8 @@ Status WriteFrameFiles(const fs::path& root, const SequenceWriterOptions& option
                             : options.exr_compression == "zip" ? cv::IMWRITE_EXR_COMPRESSION_ZIP
                                                                : cv::IMWRITE_EXR_COMPRESSION_RLE;
     return WriteImage((root / "depth" / FrameName(k, "exr")).string(), depth,
-                      {cv::IMWRITE_EXR_TYPE, cv::IMWRITE_EXR_TYPE_FLOAT, cv::IMWRITE_EXR_COMPRESSION, compression});
+                      {cv::IMWRITE_EXR_TYPE, cv::IMWRITE_EXR_TYPE_FLOAT,
+                       cv::IMWRITE_EXR_COMPRESSION, compression});
   }
   cv::Mat mm(depth.size(), CV_16UC1);
   for (int r = 0; r < mm.rows; ++r) {
@@ -184,7 +186,10 @@ Status WriteFrameFiles(const fs::path& root, const SequenceWriterOptions& option
 class FileWriterThread {
  public:
   FileWriterThread(fs::path root, const SequenceWriterOptions& options)
-      : root_(std::move(root)), options_(options), queue_(4, QueueFullPolicy::kBlock), thread_([this] { Run(); }) {}
+      : root_(std::move(root)),
+        options_(options),
+        queue_(4, QueueFullPolicy::kBlock),
+        thread_([this] { Run(); }) {}
   ~FileWriterThread() { Finish(); }
 
   bool Push(int k, cv::Mat image, cv::Mat mask, cv::Mat depth) {
@@ -276,14 +281,16 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
     if (files) {
       // The writer thread shares the frame's buffers; RenderFrame allocates new ones for
       // the next frame, so nothing is written into them again.
-      if (!files->Push(k, options.color_images ? frame.image_bgr : frame.image_gray, frame.mask, frame.depth)) {
+      if (!files->Push(k, options.color_images ? frame.image_bgr : frame.image_gray, frame.mask,
+                       frame.depth)) {
         return files->Finish();
       }
     }
     if (log) {
       while (next_odometry < odometry.size() && odometry[next_odometry].utime <= frame.utime) {
         const auto& o = odometry[next_odometry++];
-        MBSLAM_RETURN_IF_ERROR(log->Write(options.channels.odometry, o.utime, MakeOdometryMessage(o)));
+        MBSLAM_RETURN_IF_ERROR(
+            log->Write(options.channels.odometry, o.utime, MakeOdometryMessage(o)));
       }
       if (k == 0 || frame.utime - last_calibration >= calibration_period) {
         last_calibration = frame.utime;
@@ -302,7 +309,8 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
   if (log) {
     while (next_odometry < odometry.size()) {
       const auto& o = odometry[next_odometry++];
-      MBSLAM_RETURN_IF_ERROR(log->Write(options.channels.odometry, o.utime, MakeOdometryMessage(o)));
+      MBSLAM_RETURN_IF_ERROR(
+          log->Write(options.channels.odometry, o.utime, MakeOdometryMessage(o)));
     }
     log->Flush();
     summary->lcm_events = log->events_written();
@@ -314,27 +322,31 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
 
   if (options.write_files) {
     const SimOptions& so = sim->options();
-    MBSLAM_RETURN_IF_ERROR(WriteStringAtomically(
-        (root / "scenario.yaml").string(),
-        "# mbslam-sim: scenario " + so.scenario + " (" + ScenarioDescription(so.scenario) + ")\n" +
-            OptionsToYaml(so)));
-    MBSLAM_RETURN_IF_ERROR(
-        WriteStringAtomically((root / "calibration.yaml").string(), CameraIntrinsicsToYaml(sim->intrinsics())));
+    MBSLAM_RETURN_IF_ERROR(WriteStringAtomically((root / "scenario.yaml").string(),
+                                                 "# mbslam-sim: scenario " + so.scenario + " (" +
+                                                     ScenarioDescription(so.scenario) + ")\n" +
+                                                     OptionsToYaml(so)));
+    MBSLAM_RETURN_IF_ERROR(WriteStringAtomically((root / "calibration.yaml").string(),
+                                                 CameraIntrinsicsToYaml(sim->intrinsics())));
     MBSLAM_RETURN_IF_ERROR(WriteStringAtomically((root / "timestamps.txt").string(), timestamps));
-    MBSLAM_RETURN_IF_ERROR(eval::WriteTumTrajectory((root / "cam_trajectory.tum").string(), cam_traj,
+    MBSLAM_RETURN_IF_ERROR(eval::WriteTumTrajectory((root / "cam_trajectory.tum").string(),
+                                                    cam_traj,
                                                     "world_from_cam, scenario " + so.scenario));
     MBSLAM_RETURN_IF_ERROR(MakeDirs((root / "objects").string()));
-    std::string objects_yaml = "# moving bodies: id (mask value), name, full box size along body x y z (m),\n"
-                               "# body origin at the box centre, x forward, z up\nobjects:\n";
+    std::string objects_yaml =
+        "# moving bodies: id (mask value), name, full box size along body x y z (m),\n"
+        "# body origin at the box centre, x forward, z up\nobjects:\n";
     for (size_t i = 0; i < ids.size(); ++i) {
-      const SceneBody& body = sim->scene().bodies[static_cast<size_t>(sim->scene().BodyIndex(ids[i]))];
-      MBSLAM_RETURN_IF_ERROR(eval::WriteTumTrajectory((root / "objects" / (std::to_string(ids[i]) + ".tum")).string(),
-                                                      object_traj[i], "world_from_object, id " + std::to_string(ids[i]) +
-                                                                          " (" + body.name + ")"));
-      objects_yaml += "  - id: " + std::to_string(ids[i]) + "\n    name: " + body.name +
-                      "\n    extent: " + Vec3Yaml(body.extent) + "\n    first_frame: 0\n    last_frame: " +
-                      std::to_string(sim->num_frames() - 1) +
-                      "\n    frames_visible: " + std::to_string(summary->frames_visible[i]) + "\n";
+      const SceneBody& body =
+          sim->scene().bodies[static_cast<size_t>(sim->scene().BodyIndex(ids[i]))];
+      MBSLAM_RETURN_IF_ERROR(eval::WriteTumTrajectory(
+          (root / "objects" / (std::to_string(ids[i]) + ".tum")).string(), object_traj[i],
+          "world_from_object, id " + std::to_string(ids[i]) + " (" + body.name + ")"));
+      objects_yaml +=
+          "  - id: " + std::to_string(ids[i]) + "\n    name: " + body.name +
+          "\n    extent: " + Vec3Yaml(body.extent) +
+          "\n    first_frame: 0\n    last_frame: " + std::to_string(sim->num_frames() - 1) +
+          "\n    frames_visible: " + std::to_string(summary->frames_visible[i]) + "\n";
     }
     if (ids.empty()) objects_yaml += "  []\n";
     MBSLAM_RETURN_IF_ERROR(WriteStringAtomically((root / "objects.yaml").string(), objects_yaml));
@@ -352,22 +364,22 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
       ext << "# base_from_cam: camera pose in the robot base frame (base x forward, y left, z up;\n"
           << "# camera x right, y down, z forward)\n"
           << "translation: " << Vec3Yaml(e.translation) << "  # m\n"
-          << "quaternion: [" << e.rotation.w() << ", " << e.rotation.x() << ", " << e.rotation.y() << ", "
-          << e.rotation.z() << "]  # [w, x, y, z]\n";
+          << "quaternion: [" << e.rotation.w() << ", " << e.rotation.x() << ", " << e.rotation.y()
+          << ", " << e.rotation.z() << "]  # [w, x, y, z]\n";
       MBSLAM_RETURN_IF_ERROR(WriteStringAtomically((root / "extrinsic.yaml").string(), ext.str()));
     }
     if (options.write_points) {
       MBSLAM_RETURN_IF_ERROR(MakeDirs((root / "points").string()));
       for (const auto& body : sim->scene().bodies) {
-        std::string text = "# ground-truth surface points of body " + std::to_string(body.id) + " (" + body.name +
-                           "), body frame: x y z (m)\n";
+        std::string text = "# ground-truth surface points of body " + std::to_string(body.id) +
+                           " (" + body.name + "), body frame: x y z (m)\n";
         char buf[96];
         for (const auto& p : sim->SurfacePoints(body.id)) {
           std::snprintf(buf, sizeof(buf), "%.6f %.6f %.6f\n", p.x(), p.y(), p.z());
           text += buf;
         }
-        MBSLAM_RETURN_IF_ERROR(
-            WriteStringAtomically((root / "points" / (std::to_string(body.id) + ".txt")).string(), text));
+        MBSLAM_RETURN_IF_ERROR(WriteStringAtomically(
+            (root / "points" / (std::to_string(body.id) + ".txt")).string(), text));
       }
     }
   }

@@ -1,9 +1,9 @@
 #include "tools/sim/sequence_writer.h"
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include <filesystem>
 #include <map>
@@ -24,7 +24,8 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("mbslam_sim_test_" + std::to_string(::getpid()) + "_" + name);
+  const fs::path dir =
+      fs::temp_directory_path() / ("mbslam_sim_test_" + std::to_string(::getpid()) + "_" + name);
   fs::remove_all(dir);
   return dir.string();
 }
@@ -56,14 +57,16 @@ TEST(SequenceWriter, FolderAndLogMatchTheSimulator) {
   options.calibration_period_s = 0.5;
   SequenceSummary summary;
   int progress_calls = 0;
-  ASSERT_TRUE(WriteSequence(sim.get(), dir, options, &summary, [&](int) { ++progress_calls; }).ok());
+  ASSERT_TRUE(
+      WriteSequence(sim.get(), dir, options, &summary, [&](int) { ++progress_calls; }).ok());
   EXPECT_EQ(summary.frames, 40);
   EXPECT_EQ(progress_calls, 40);
 
-  for (const char* f : {"scenario.yaml", "calibration.yaml", "timestamps.txt", "cam_trajectory.tum", "objects.yaml",
-                        "odometry.tum", "odometry_truth.tum", "extrinsic.yaml", "sequence.lcmlog", "points/0.txt",
-                        "points/1.txt", "objects/1.tum", "images/000000.png", "images/000039.png",
-                        "masks/000039.png", "depth/000039.exr"}) {
+  for (const char* f :
+       {"scenario.yaml", "calibration.yaml", "timestamps.txt", "cam_trajectory.tum", "objects.yaml",
+        "odometry.tum", "odometry_truth.tum", "extrinsic.yaml", "sequence.lcmlog", "points/0.txt",
+        "points/1.txt", "objects/1.tum", "images/000000.png", "images/000039.png",
+        "masks/000039.png", "depth/000039.exr"}) {
     EXPECT_TRUE(fs::exists(fs::path(dir) / f)) << f;
   }
   EXPECT_FALSE(fs::exists(fs::path(dir) / "images/000040.png"));
@@ -81,7 +84,9 @@ TEST(SequenceWriter, FolderAndLogMatchTheSimulator) {
   ASSERT_EQ(cam.size(), 40u);
   for (int k = 0; k < 40; ++k) {
     EXPECT_EQ(cam[static_cast<size_t>(k)].utime, sim->FrameUtime(k));
-    EXPECT_LT(TranslationDistance(cam[static_cast<size_t>(k)].pose, sim->WorldFromCam(sim->FrameUtime(k))), 1e-8);
+    EXPECT_LT(TranslationDistance(cam[static_cast<size_t>(k)].pose,
+                                  sim->WorldFromCam(sim->FrameUtime(k))),
+              1e-8);
   }
   eval::Trajectory obj;
   ASSERT_TRUE(eval::ReadTumTrajectory(dir + "/objects/2.tum", &obj).ok());
@@ -158,9 +163,10 @@ TEST(SequenceWriter, FolderAndLogMatchTheSimulator) {
       const auto msg = Decode<mbslam::odometry_t>(e);
       EXPECT_EQ(msg.utime, e.timestamp);
       EXPECT_EQ(msg.frame_id, "odom");
-      EXPECT_NEAR(msg.orientation[0] * msg.orientation[0] + msg.orientation[3] * msg.orientation[3] +
-                      msg.orientation[1] * msg.orientation[1] + msg.orientation[2] * msg.orientation[2],
-                  1.0, 1e-9);
+      EXPECT_NEAR(
+          msg.orientation[0] * msg.orientation[0] + msg.orientation[3] * msg.orientation[3] +
+              msg.orientation[1] * msg.orientation[1] + msg.orientation[2] * msg.orientation[2],
+          1.0, 1e-9);
     } else {
       ADD_FAILURE() << "unexpected channel " << e.channel;
     }

@@ -92,27 +92,48 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--list") list = true;
-    else if (a == "--scenario") scenario = next();
-    else if (a == "--out") out_dir = next();
-    else if (a == "--config") config = next();
-    else if (a == "--print-config") print_config = true;
-    else if (a == "--frames") frames = std::atoi(next().c_str());
-    else if (a == "--size") size = next();
-    else if (a == "--fps") fps = std::atof(next().c_str());
-    else if (a == "--seed") seed = std::atoll(next().c_str());
-    else if (a == "--noise") noise = std::atof(next().c_str());
-    else if (a == "--blur") blur = std::atoi(next().c_str());
-    else if (a == "--color") writer.color_images = true;
-    else if (a == "--depth") writer.depth_format = next();
-    else if (a == "--image-encoding") writer.lcm_image_encoding = next();
-    else if (a == "--no-files") writer.write_files = false;
-    else if (a == "--no-lcm") writer.write_lcm = false;
-    else if (a == "--check") check = true;
-    else if (a == "--check-frames") check_frames = std::atoi(next().c_str());
-    else if (a == "--quiet") quiet = true;
-    else if (a == "--verbose") mbslam::SetLogLevel(mbslam::LogLevel::kDebug);
-    else if (a == "--json") json_file = next();
+    if (a == "--list")
+      list = true;
+    else if (a == "--scenario")
+      scenario = next();
+    else if (a == "--out")
+      out_dir = next();
+    else if (a == "--config")
+      config = next();
+    else if (a == "--print-config")
+      print_config = true;
+    else if (a == "--frames")
+      frames = std::atoi(next().c_str());
+    else if (a == "--size")
+      size = next();
+    else if (a == "--fps")
+      fps = std::atof(next().c_str());
+    else if (a == "--seed")
+      seed = std::atoll(next().c_str());
+    else if (a == "--noise")
+      noise = std::atof(next().c_str());
+    else if (a == "--blur")
+      blur = std::atoi(next().c_str());
+    else if (a == "--color")
+      writer.color_images = true;
+    else if (a == "--depth")
+      writer.depth_format = next();
+    else if (a == "--image-encoding")
+      writer.lcm_image_encoding = next();
+    else if (a == "--no-files")
+      writer.write_files = false;
+    else if (a == "--no-lcm")
+      writer.write_lcm = false;
+    else if (a == "--check")
+      check = true;
+    else if (a == "--check-frames")
+      check_frames = std::atoi(next().c_str());
+    else if (a == "--quiet")
+      quiet = true;
+    else if (a == "--verbose")
+      mbslam::SetLogLevel(mbslam::LogLevel::kDebug);
+    else if (a == "--json")
+      json_file = next();
     else if (a == "-h" || a == "--help") {
       Usage();
       return 0;
@@ -175,12 +196,14 @@ int main(int argc, char** argv) {
   const double setup_s = 1e-6 * static_cast<double>(mbslam::MonotonicUtime() - t0);
   const auto& K = simulator->intrinsics();
   MBSLAM_LOG(INFO) << "scenario " << options.scenario << ": " << simulator->MovingBodyIds().size()
-                   << " moving bodies, " << options.num_frames << " frames at " << K.width << "x" << K.height
-                   << ", set-up " << setup_s << " s";
+                   << " moving bodies, " << options.num_frames << " frames at " << K.width << "x"
+                   << K.height << ", set-up " << setup_s << " s";
 
-  std::string json = "{\"scenario\": \"" + options.scenario + "\", \"frames\": " +
-                     std::to_string(options.num_frames) + ", \"width\": " + std::to_string(K.width) +
-                     ", \"height\": " + std::to_string(K.height) + ", \"setup_s\": " + std::to_string(setup_s);
+  std::string json = "{\"scenario\": \"" + options.scenario +
+                     "\", \"frames\": " + std::to_string(options.num_frames) +
+                     ", \"width\": " + std::to_string(K.width) +
+                     ", \"height\": " + std::to_string(K.height) +
+                     ", \"setup_s\": " + std::to_string(setup_s);
   if (!out_dir.empty()) {
     sim::SequenceSummary summary;
     status = sim::WriteSequence(simulator.get(), out_dir, writer, &summary, [&](int k) {
@@ -190,14 +213,17 @@ int main(int argc, char** argv) {
       std::cerr << "mbslam-sim: " << status.message() << "\n";
       return 1;
     }
-    const double fps_render = summary.render_seconds > 0 ? summary.frames / summary.render_seconds : 0.0;
-    const double fps_total = summary.total_seconds > 0 ? summary.frames / summary.total_seconds : 0.0;
-    Say("wrote %d frames of '%s' to %s\n", summary.frames, options.scenario.c_str(), out_dir.c_str());
-    Say("  rendering: %.1f frames/s; rendering + writing: %.1f frames/s; set-up %.2f s\n", fps_render,
-                fps_total, setup_s);
+    const double fps_render =
+        summary.render_seconds > 0 ? summary.frames / summary.render_seconds : 0.0;
+    const double fps_total =
+        summary.total_seconds > 0 ? summary.frames / summary.total_seconds : 0.0;
+    Say("wrote %d frames of '%s' to %s\n", summary.frames, options.scenario.c_str(),
+        out_dir.c_str());
+    Say("  rendering: %.1f frames/s; rendering + writing: %.1f frames/s; set-up %.2f s\n",
+        fps_render, fps_total, setup_s);
     Say("  image covered by moving bodies: mean %.1f %%, min %.1f %%, max %.1f %%\n",
-                100.0 * summary.mean_moving_fraction, 100.0 * summary.min_moving_fraction,
-                100.0 * summary.max_moving_fraction);
+        100.0 * summary.mean_moving_fraction, 100.0 * summary.min_moving_fraction,
+        100.0 * summary.max_moving_fraction);
     std::string visible = "[";
     for (size_t i = 0; i < summary.frames_visible.size(); ++i) {
       visible += (i ? ", " : "") + std::to_string(summary.frames_visible[i]);
@@ -209,7 +235,8 @@ int main(int argc, char** argv) {
             ", \"total_fps\": " + std::to_string(fps_total) +
             ", \"mean_moving_fraction\": " + std::to_string(summary.mean_moving_fraction) +
             ", \"min_moving_fraction\": " + std::to_string(summary.min_moving_fraction) +
-            ", \"frames_visible\": " + visible + ", \"lcm_events\": " + std::to_string(summary.lcm_events) +
+            ", \"frames_visible\": " + visible +
+            ", \"lcm_events\": " + std::to_string(summary.lcm_events) +
             ", \"odometry_samples\": " + std::to_string(summary.odometry_samples);
   }
   if (check) {
@@ -218,26 +245,33 @@ int main(int argc, char** argv) {
     sim::SimFrame frame;
     const int n = std::max(1, std::min(check_frames, options.num_frames));
     for (int i = 0; i < n; ++i) {
-      const int k = n == 1 ? 0 : static_cast<int>(static_cast<int64_t>(i) * (options.num_frames - 1) / (n - 1));
+      const int k =
+          n == 1 ? 0
+                 : static_cast<int>(static_cast<int64_t>(i) * (options.num_frames - 1) / (n - 1));
       status = simulator->RenderFrame(k, &frame, sim::RenderRequest{false, true});
-      if (status.ok()) status = sim::CheckFrameGroundTruth(*simulator, frame, check_options, &report);
+      if (status.ok())
+        status = sim::CheckFrameGroundTruth(*simulator, frame, check_options, &report);
       if (!status.ok()) {
         std::cerr << "mbslam-sim: " << status.message() << "\n";
         return 1;
       }
     }
     Say("ground-truth check of '%s' over %d frames:\n", options.scenario.c_str(), report.frames);
-    Say("  visible surface samples: %lld (%lld on movers), label error max %.4f px, failures %lld\n",
-                static_cast<long long>(report.samples_visible), static_cast<long long>(report.samples_visible_moving),
-                report.label_max_px, static_cast<long long>(report.label_failures));
+    Say("  visible surface samples: %lld (%lld on movers), label error max %.4f px, failures "
+        "%lld\n",
+        static_cast<long long>(report.samples_visible),
+        static_cast<long long>(report.samples_visible_moving), report.label_max_px,
+        static_cast<long long>(report.label_failures));
     Say("  sub-pixel reprojection of samples: max %.5f px, rms %.5f px (%lld samples)\n",
-                report.reprojection_max_px, report.reprojection_rms_px,
-                static_cast<long long>(report.reprojection_samples));
-    Say("  pixels vs ray casts: %lld, label mismatches %lld (%lld on silhouettes), depth error max %.2e m "
-                "(rel %.2e)\n",
-                static_cast<long long>(report.pixels), static_cast<long long>(report.pixel_label_mismatches),
-                static_cast<long long>(report.pixel_label_mismatches_on_edges), report.depth_max_abs_error_m,
-                report.depth_max_rel_error);
+        report.reprojection_max_px, report.reprojection_rms_px,
+        static_cast<long long>(report.reprojection_samples));
+    Say("  pixels vs ray casts: %lld, label mismatches %lld (%lld on silhouettes), depth error max "
+        "%.2e m "
+        "(rel %.2e)\n",
+        static_cast<long long>(report.pixels),
+        static_cast<long long>(report.pixel_label_mismatches),
+        static_cast<long long>(report.pixel_label_mismatches_on_edges),
+        report.depth_max_abs_error_m, report.depth_max_rel_error);
     json += ", \"check\": " + report.ToJson();
   }
   json += "}";

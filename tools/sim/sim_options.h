@@ -47,10 +47,10 @@ struct SimCameraOptions {
 };
 
 struct SimImageOptions {
-  double noise_sigma = 0.0;         // Gaussian pixel noise, standard deviation (grey levels)
-  int motion_blur_samples = 1;      // sub-frames averaged over the exposure; 1 = no blur (count)
-  double exposure_ms = 12.0;        // exposure time used for motion blur (ms)
-  RendererOptions render;           // renderer settings
+  double noise_sigma = 0.0;     // Gaussian pixel noise, standard deviation (grey levels)
+  int motion_blur_samples = 1;  // sub-frames averaged over the exposure; 1 = no blur (count)
+  double exposure_ms = 12.0;    // exposure time used for motion blur (ms)
+  RendererOptions render;       // renderer settings
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(noise_sigma, 0.0);
@@ -63,7 +63,8 @@ struct SimImageOptions {
   template <typename V>
   void VisitFields(V& v) {
     v("noise_sigma", &noise_sigma, "Gaussian pixel noise, standard deviation (grey levels)");
-    v("motion_blur_samples", &motion_blur_samples, "sub-frames averaged over the exposure; 1 = off (count)");
+    v("motion_blur_samples", &motion_blur_samples,
+      "sub-frames averaged over the exposure; 1 = off (count)");
     v("exposure_ms", &exposure_ms, "exposure time used for motion blur (ms)");
     v("render", &render, "renderer settings");
   }
@@ -73,9 +74,10 @@ struct SimImageOptions {
 // measured forward speed and yaw rate get a constant scale error, a yaw-rate bias and
 // white noise, and are integrated into a drifting odom_from_base.
 struct SimOdometryOptions {
-  double rate_hz = 50.0;               // sample rate (Hz)
-  int64_t time_offset_us = 3000;       // time of the first sample after the first image (µs)
-  double speed_scale_error = 0.015;    // relative error of the measured speed (fraction; sign from the seed)
+  double rate_hz = 50.0;          // sample rate (Hz)
+  int64_t time_offset_us = 3000;  // time of the first sample after the first image (µs)
+  double speed_scale_error =
+      0.015;  // relative error of the measured speed (fraction; sign from the seed)
   double yaw_rate_scale_error = 0.02;  // relative error of the measured yaw rate (fraction)
   double yaw_rate_bias = 0.004;        // constant yaw-rate bias (rad/s)
   double speed_noise = 0.02;           // white noise on each speed sample (m/s)
@@ -96,7 +98,8 @@ struct SimOdometryOptions {
     v("rate_hz", &rate_hz, "sample rate (Hz)");
     v("time_offset_us", &time_offset_us, "time of the first sample after the first image (µs)");
     v("speed_scale_error", &speed_scale_error, "relative error of the measured speed (fraction)");
-    v("yaw_rate_scale_error", &yaw_rate_scale_error, "relative error of the measured yaw rate (fraction)");
+    v("yaw_rate_scale_error", &yaw_rate_scale_error,
+      "relative error of the measured yaw rate (fraction)");
     v("yaw_rate_bias", &yaw_rate_bias, "constant yaw-rate bias (rad/s)");
     v("speed_noise", &speed_noise, "white noise on each speed sample (m/s)");
     v("yaw_rate_noise", &yaw_rate_noise, "white noise on each yaw-rate sample (rad/s)");
@@ -104,20 +107,21 @@ struct SimOdometryOptions {
 };
 
 struct SimOptions {
-  std::string scenario = "static";            // one of ScenarioNames()
-  int64_t seed = 1;                           // seed of everything random (world, textures, noise)
-  int num_frames = 300;                       // images in the sequence (count)
-  double fps = 30.0;                          // image rate (Hz)
-  int64_t start_utime = 1600000000000000;     // time of the first image (µs)
-  double texel_m = 0.006;                     // texel size of surfaces near the camera at fx = 525 (m)
-  double lod_distance_m = 6.0;                // texel size grows beyond this distance from the camera path (m)
-  int max_texture_px = 1024;                  // largest texture side (px)
-  double static_points_per_m2 = 20.0;         // ground-truth samples of the static world near the camera path (1/m^2)
-  double object_points_per_m2 = 400.0;        // ground-truth surface samples of moving objects (1/m^2)
-  int max_points_per_body = 60000;            // cap on ground-truth samples per body (count)
-  SimCameraOptions camera;                    // camera model and image size
-  SimImageOptions image;                      // noise, blur, rendering
-  SimOdometryOptions odometry;                // wheel odometry (robot scenarios)
+  std::string scenario = "static";         // one of ScenarioNames()
+  int64_t seed = 1;                        // seed of everything random (world, textures, noise)
+  int num_frames = 300;                    // images in the sequence (count)
+  double fps = 30.0;                       // image rate (Hz)
+  int64_t start_utime = 1600000000000000;  // time of the first image (µs)
+  double texel_m = 0.006;                  // texel size of surfaces near the camera at fx = 525 (m)
+  double lod_distance_m = 6.0;  // texel size grows beyond this distance from the camera path (m)
+  int max_texture_px = 1024;    // largest texture side (px)
+  double static_points_per_m2 =
+      20.0;  // ground-truth samples of the static world near the camera path (1/m^2)
+  double object_points_per_m2 = 400.0;  // ground-truth surface samples of moving objects (1/m^2)
+  int max_points_per_body = 60000;      // cap on ground-truth samples per body (count)
+  SimCameraOptions camera;              // camera model and image size
+  SimImageOptions image;                // noise, blur, rendering
+  SimOdometryOptions odometry;          // wheel odometry (robot scenarios)
 
   // Time of image k (µs).
   int64_t FrameUtime(int k) const;
@@ -148,11 +152,13 @@ struct SimOptions {
     v("fps", &fps, "image rate (Hz)");
     v("start_utime", &start_utime, "time of the first image (µs)");
     v("texel_m", &texel_m, "texel size of surfaces near the camera at fx = 525 (m)");
-    v("lod_distance_m", &lod_distance_m, "texel size grows beyond this distance from the camera path (m)");
+    v("lod_distance_m", &lod_distance_m,
+      "texel size grows beyond this distance from the camera path (m)");
     v("max_texture_px", &max_texture_px, "largest texture side (px)");
     v("static_points_per_m2", &static_points_per_m2,
       "ground-truth samples of the static world near the camera path, fewer with distance (1/m^2)");
-    v("object_points_per_m2", &object_points_per_m2, "ground-truth samples of moving objects (1/m^2)");
+    v("object_points_per_m2", &object_points_per_m2,
+      "ground-truth samples of moving objects (1/m^2)");
     v("max_points_per_body", &max_points_per_body, "cap on ground-truth samples per body (count)");
     v("camera", &camera, "camera model and image size");
     v("image", &image, "noise, blur, rendering");

@@ -141,7 +141,8 @@ Status Simulator::RenderFrame(int k, SimFrame* frame, const RenderRequest& reque
   frame->depth.release();
   frame->points_in_cam.release();
   if (request.geometry) {
-    MBSLAM_RETURN_IF_ERROR(renderer_->RenderGeometry(CamFromBodies(frame->utime), &frame->mask, &frame->points_in_cam));
+    MBSLAM_RETURN_IF_ERROR(renderer_->RenderGeometry(CamFromBodies(frame->utime), &frame->mask,
+                                                     &frame->points_in_cam));
     cv::extractChannel(frame->points_in_cam, frame->depth, 2);
     std::vector<int> counts(65536, 0);
     for (int r = 0; r < frame->mask.rows; ++r) {
@@ -156,7 +157,8 @@ Status Simulator::RenderFrame(int k, SimFrame* frame, const RenderRequest& reque
   if (request.image) {
     const int samples = options_.image.motion_blur_samples;
     if (samples <= 1) {
-      MBSLAM_RETURN_IF_ERROR(renderer_->RenderColor(CamFromBodies(frame->utime), &frame->image_bgr));
+      MBSLAM_RETURN_IF_ERROR(
+          renderer_->RenderColor(CamFromBodies(frame->utime), &frame->image_bgr));
     } else {
       cv::Mat sum(intrinsics_.height, intrinsics_.width, CV_32FC3, cv::Scalar::all(0));
       cv::Mat sub;
@@ -171,7 +173,8 @@ Status Simulator::RenderFrame(int k, SimFrame* frame, const RenderRequest& reque
     }
     cv::cvtColor(frame->image_bgr, frame->image_gray, cv::COLOR_BGR2GRAY);
     if (options_.image.noise_sigma > 0.0) {
-      cv::RNG rng(static_cast<uint64_t>(options_.seed) * 2654435761ULL + static_cast<uint64_t>(k) + 1);
+      cv::RNG rng(static_cast<uint64_t>(options_.seed) * 2654435761ULL + static_cast<uint64_t>(k) +
+                  1);
       for (cv::Mat* img : {&frame->image_bgr, &frame->image_gray}) {
         cv::Mat noise(img->size(), CV_MAKETYPE(CV_32F, img->channels()));
         rng.fill(noise, cv::RNG::NORMAL, 0.0, options_.image.noise_sigma);
@@ -198,8 +201,9 @@ void Simulator::GenerateOdometry() {
   // The odometry frame: the base's planar pose at the first sample.
   const Rigid3d world_from_base0 = base.WorldFromBody(first);
   const Eigen::Vector3d x_axis = world_from_base0.rotation * Eigen::Vector3d::UnitX();
-  const Rigid3d world_from_odom = PlanarPose(world_from_base0.translation.x(), world_from_base0.translation.y(),
-                                             0.0, std::atan2(x_axis.y(), x_axis.x()));
+  const Rigid3d world_from_odom =
+      PlanarPose(world_from_base0.translation.x(), world_from_base0.translation.y(), 0.0,
+                 std::atan2(x_axis.y(), x_axis.x()));
   const Rigid3d odom_from_world = world_from_odom.Inverse();
 
   auto measured = [&](int64_t utime, double* v, double* w) {
@@ -218,7 +222,8 @@ void Simulator::GenerateOdometry() {
   int64_t prev_t = first;
   int64_t seq = 0;
   for (int64_t j = 0;; ++j) {
-    const int64_t t = first + static_cast<int64_t>(std::llround(static_cast<double>(j) * 1e6 / o.rate_hz));
+    const int64_t t =
+        first + static_cast<int64_t>(std::llround(static_cast<double>(j) * 1e6 / o.rate_hz));
     if (t > last) break;
     double v_true, w_true;
     measured(t, &v_true, &w_true);
@@ -257,11 +262,12 @@ void Simulator::GenerateOdometry() {
     sample.angular_velocity = Eigen::Vector3d(0.0, 0.0, w_m);
     const double elapsed = 1e-6 * static_cast<double>(t - first);
     const double pos_sigma_sq = var_xy + std::pow(o.speed_scale_error * distance, 2);
-    const double yaw_sigma_sq =
-        var_yaw + std::pow(o.yaw_rate_bias * elapsed, 2) + std::pow(o.yaw_rate_scale_error * turned, 2);
+    const double yaw_sigma_sq = var_yaw + std::pow(o.yaw_rate_bias * elapsed, 2) +
+                                std::pow(o.yaw_rate_scale_error * turned, 2);
     sample.pose_covariance.diagonal() << pos_sigma_sq + yaw_sigma_sq * distance * distance,
         pos_sigma_sq + yaw_sigma_sq * distance * distance, 1e-6, 1e-6, 1e-6, yaw_sigma_sq + 1e-8;
-    sample.twist_covariance.diagonal() << std::pow(o.speed_noise, 2) + std::pow(o.speed_scale_error * v_true, 2),
+    sample.twist_covariance.diagonal()
+        << std::pow(o.speed_noise, 2) + std::pow(o.speed_scale_error * v_true, 2),
         1e-4, 1e-4, 1e-4, 1e-4, std::pow(o.yaw_rate_noise, 2) + std::pow(o.yaw_rate_bias, 2);
     odometry_.push_back(sample);
   }

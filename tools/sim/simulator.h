@@ -42,28 +42,30 @@ namespace sim {
 
 // Ground truth of one moving body at one image.
 struct SimBodyState {
-  int id = 0;                     // mask value (> 0)
-  std::string name;               // "car", "person", "robot", "box"
-  Eigen::Vector3d extent = Eigen::Vector3d::Zero();  // full box size along body x, y, z (m); origin at its centre
+  int id = 0;        // mask value (> 0)
+  std::string name;  // "car", "person", "robot", "box"
+  Eigen::Vector3d extent =
+      Eigen::Vector3d::Zero();  // full box size along body x, y, z (m); origin at its centre
   Rigid3d world_from_body;
-  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   // of the body origin, world frame (m/s)
+  Eigen::Vector3d linear_velocity =
+      Eigen::Vector3d::Zero();  // of the body origin, world frame (m/s)
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // world frame (rad/s)
-  int pixel_count = -1;           // pixels with this id in the mask; -1 if the mask was not rendered
-  bool visible = false;           // pixel_count > 0 (false if not rendered)
+  int pixel_count = -1;  // pixels with this id in the mask; -1 if the mask was not rendered
+  bool visible = false;  // pixel_count > 0 (false if not rendered)
 };
 
 struct SimFrame {
   int index = 0;
-  int64_t utime = 0;                   // time of the image (centre of exposure) (µs)
-  Rigid3d world_from_cam;              // camera axes x right, y down, z forward
+  int64_t utime = 0;       // time of the image (centre of exposure) (µs)
+  Rigid3d world_from_cam;  // camera axes x right, y down, z forward
   Eigen::Vector3d cam_linear_velocity = Eigen::Vector3d::Zero();   // world frame (m/s)
   Eigen::Vector3d cam_angular_velocity = Eigen::Vector3d::Zero();  // world frame (rad/s)
-  std::vector<SimBodyState> bodies;    // every moving body, ascending id
-  cv::Mat image_bgr;                   // CV_8UC3
-  cv::Mat image_gray;                  // CV_8UC1 (from the same render, own noise draw)
-  cv::Mat mask;                        // CV_16UC1 body id per pixel (0 = static world and sky)
-  cv::Mat depth;                       // CV_32FC1 z along the optical axis (m); 0 = no surface (sky)
-  cv::Mat points_in_cam;               // CV_32FC3 surface point at each pixel centre, camera frame (m)
+  std::vector<SimBodyState> bodies;  // every moving body, ascending id
+  cv::Mat image_bgr;                 // CV_8UC3
+  cv::Mat image_gray;                // CV_8UC1 (from the same render, own noise draw)
+  cv::Mat mask;                      // CV_16UC1 body id per pixel (0 = static world and sky)
+  cv::Mat depth;                     // CV_32FC1 z along the optical axis (m); 0 = no surface (sky)
+  cv::Mat points_in_cam;  // CV_32FC3 surface point at each pixel centre, camera frame (m)
 
   // Fraction of the pixels that belong to moving bodies (needs the mask).
   double MovingFraction() const;
@@ -79,10 +81,10 @@ struct RenderRequest {
 struct OdometrySample {
   int64_t utime = 0;
   int64_t seq = 0;
-  Rigid3d odom_from_base;                   // odom frame = base pose at the first sample
+  Rigid3d odom_from_base;  // odom frame = base pose at the first sample
   Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   // base frame (m/s)
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // base frame (rad/s)
-  Matrix6d pose_covariance = Matrix6d::Zero();   // [x y z rx ry rz] (m^2, rad^2)
+  Matrix6d pose_covariance = Matrix6d::Zero();                 // [x y z rx ry rz] (m^2, rad^2)
   Matrix6d twist_covariance = Matrix6d::Zero();  // [vx vy vz wx wy wz] (m^2/s^2, rad^2/s^2)
 };
 

@@ -57,11 +57,14 @@ TEST_P(ScenarioGroundTruth, ProjectionsMasksAndDepthAgree) {
   EXPECT_EQ(report.pixel_label_mismatches, report.pixel_label_mismatches_on_edges);
   EXPECT_LE(report.pixel_label_mismatches, report.pixels / 2000);
   EXPECT_LE(report.depth_max_rel_error, 2e-4);
+  EXPECT_LE(report.depth_max_error_px, 0.05);
   EXPECT_LE(report.pixel_backprojection_max_px, 0.01);
 }
 
 INSTANTIATE_TEST_SUITE_P(AllScenarios, ScenarioGroundTruth, ::testing::ValuesIn(ScenarioNames()),
-                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           return info.param;
+                         });
 
 TEST(Simulator, DeterministicAndOrderIndependent) {
   SimOptions o = SmallOptions("crossing");
