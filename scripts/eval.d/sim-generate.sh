@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # generates every simulator scenario at 640x480 (sequence folders + LCM logs) and reports frames per second
 #
-# Usage: scripts/eval.sh sim-generate [FRAMES]   (default 300 frames per scenario)
+# Usage: scripts/eval.sh sim-generate [FRAMES [SCENARIO...]]   (default: 300 frames, every scenario)
 # Writes $MBSLAM_EVAL_OUT/<scenario>/ and prints a summary and, as the last line, one
 # JSON object with the generator's frames per second per scenario (rendering only, and
 # rendering + writing files and log) and the image coverage of the moving bodies.
@@ -10,6 +10,7 @@ root="${MBSLAM_ROOT:-$(cd "$(dirname "$0")/../.." && pwd)}"
 bin="${MBSLAM_BIN:-$root/build/bin}"
 out="${MBSLAM_EVAL_OUT:-$root/out/eval/sim-generate}"
 frames="${1:-300}"
+shift || true
 mkdir -p "$out"
 if [[ ! -x "$bin/mbslam-sim" ]]; then
   echo "sim-generate: $bin/mbslam-sim not built" >&2
@@ -25,7 +26,11 @@ total_json=""
 coverage_json=""
 min_render=""
 echo "== $frames frames per scenario at 640x480 into $out"
-for s in $("$bin/mbslam-sim" --list | awk '{print $1}'); do
+scenarios=("$@")
+if [[ ${#scenarios[@]} -eq 0 ]]; then
+  mapfile -t scenarios < <("$bin/mbslam-sim" --list | awk '{print $1}')
+fi
+for s in "${scenarios[@]}"; do
   "$bin/mbslam-sim" --quiet --scenario "$s" --size 640x480 --frames "$frames" --out "$out/$s" --json "$out/$s.json"
   f="$out/$s.json"
   render=$(json_get "$f" render_fps)
