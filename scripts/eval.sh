@@ -18,6 +18,7 @@ if [[ $# -lt 1 || "$1" == "list" || "$1" == "-h" || "$1" == "--help" ]]; then
   for f in scripts/eval.d/*.sh; do
     [[ -e "$f" ]] || continue
     name=$(basename "$f" .sh)
+    [[ "$name" == _* ]] && continue  # helpers, not evaluations
     desc=$(sed -n '2s/^# *//p' "$f")
     printf "  %-24s %s\n" "$name" "$desc"
   done
@@ -27,7 +28,7 @@ fi
 name="$1"
 shift
 script="scripts/eval.d/$name.sh"
-if [[ ! -f "$script" ]]; then
+if [[ "$name" == _* || ! -f "$script" ]]; then
   echo "eval.sh: no evaluation named '$name' (scripts/eval.sh list shows them)" >&2
   exit 2
 fi

@@ -16,6 +16,8 @@ PACKAGES=(
   libosmesa6-dev
   # tests, benchmarks, fuzzing, sanitizers
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
+  # evaluation scripts (JSON assembly)
+  python3
   # network namespaces for the udpm:// tests
   iproute2 util-linux
 )

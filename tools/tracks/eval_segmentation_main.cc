@@ -82,7 +82,7 @@ int Run(int argc, char** argv) {
     std::fprintf(stderr, "no PERCEPTION_TRACKS in %s\n", run.c_str());
     return 1;
   }
-  int64_t tp = 0, fp = 0, fn = 0, frames = 0;
+  int64_t tp = 0, fp = 0, fn = 0, tn = 0, frames = 0;
   std::map<int, int64_t> detected_frame;  // true body -> first frame its features were mostly moving with an object
   std::map<int64_t, std::map<int, int>> truth_votes, pred_votes;  // track -> body -> count
   for (const LcmLogEvent& e : events) {
@@ -134,6 +134,7 @@ int Run(int argc, char** argv) {
                     body, f.p_static, f.epipolar_px, f.fvb, f.age, dist.at<float>(v, u));
       }
       fn += truly_moving && !labelled_moving;
+      tn += !truly_moving && !labelled_moving;
     }
     frames += scored;
     for (const auto& [body, counts] : per_body) {
@@ -177,10 +178,11 @@ int Run(int argc, char** argv) {
       ++delay_n;
     }
   }
+  const double false_moving = fp + tn > 0 ? static_cast<double>(fp) / static_cast<double>(fp + tn) : 0.0;
   std::printf("{\"name\": \"%s\", \"moving_recall\": %.4f, \"moving_precision\": %.4f, \"misclassification\": %.4f, "
-              "\"frames_scored\": %lld, \"objects\": %zu, \"objects_detected\": %d, \"mean_detection_delay_frames\": %.2f, "
+              "\"false_moving_fraction\": %.5f, \"frames_scored\": %lld, \"objects\": %zu, \"objects_detected\": %d, \"mean_detection_delay_frames\": %.2f, "
               "\"detection_delay_frames\": {%s}}\n",
-              name.c_str(), recall, precision, miscl, static_cast<long long>(frames), first_moving_frame.size(),
+              name.c_str(), recall, precision, miscl, false_moving, static_cast<long long>(frames), first_moving_frame.size(),
               delay_n, delay_n ? delay_sum / delay_n : -1.0, delays.c_str());
   return 0;
 }

@@ -45,6 +45,15 @@ InterpolationResult PoseBuffer::Interpolate(int64_t utime, Rigid3d* pose) const 
   return InterpolationResult::kOk;
 }
 
+bool PoseBuffer::Extrapolate(int64_t utime, Rigid3d* pose) const {
+  if (samples_.size() < 2 || utime < samples_.back().utime) return false;
+  const StampedPose& b = samples_.back();
+  const StampedPose& a = samples_[samples_.size() - 2];
+  const double t = static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime);
+  *pose = Rigid3d::Interpolate(a.pose, b.pose, t);  // t > 1 continues the geodesic
+  return true;
+}
+
 void PoseBuffer::PruneBefore(int64_t utime) {
   while (samples_.size() >= 2 && samples_[1].utime <= utime) samples_.pop_front();
 }

@@ -42,6 +42,11 @@ class PoseBuffer {
   // equal to a sample returns it exactly.
   InterpolationResult Interpolate(int64_t utime, Rigid3d* pose) const;
 
+  // Pose at a time after the last sample, continuing the motion between the last two
+  // samples (constant twist). False with fewer than two samples or a time before the
+  // last one.
+  bool Extrapolate(int64_t utime, Rigid3d* pose) const;
+
   // Drops samples older than the last one at or before `utime`.
   void PruneBefore(int64_t utime);
   void Clear() { samples_.clear(); }

@@ -32,6 +32,15 @@ TEST(PoseBuffer, InterpolationOnKnownTrajectoryIsExact) {
   EXPECT_LT(max_err, 1e-9);
 }
 
+TEST(PoseBuffer, ExtrapolationContinuesAConstantTwist) {
+  PoseBuffer buffer;
+  for (int i = 0; i <= 10; ++i) ASSERT_TRUE(buffer.Insert(i * 20000, TrueTrajectory(i * 0.02)).ok());
+  Rigid3d pose;
+  ASSERT_TRUE(buffer.Extrapolate(230000, &pose));
+  EXPECT_LT(TranslationDistance(pose, TrueTrajectory(0.23)), 1e-9);
+  EXPECT_FALSE(buffer.Extrapolate(100000, &pose));
+}
+
 TEST(PoseBuffer, ReportsOutOfRangeAndGaps) {
   PoseBuffer buffer(/*max_gap_us=*/100000);
   Rigid3d pose;

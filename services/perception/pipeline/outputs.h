@@ -128,6 +128,9 @@ struct FrameResult {
   std::vector<ObjectOutput> objects;
   std::optional<MapOutput> map;
   std::optional<OccupancyOutput> occupancy;
+  // The world frame's units changed in this image (e.g. to metres once odometry fixed
+  // the scale): earlier world positions are to be multiplied by this factor.
+  std::optional<double> world_rescaled_by;
 };
 
 // Receives the pipeline's results on the processing thread, in frame order.

@@ -79,8 +79,14 @@ std::optional<RelativeMotion> PerceptionCore::OdometryMotion(int64_t ref_frame,
 
 std::optional<Rigid3d> PerceptionCore::OdometryCameraPose(int64_t utime) const {
   Rigid3d odom_from_base;
-  if (odometry_.Interpolate(utime, &odom_from_base) != InterpolationResult::kOk) return std::nullopt;
-  return odom_from_base * base_from_cam_;
+  const InterpolationResult r = odometry_.Interpolate(utime, &odom_from_base);
+  if (r == InterpolationResult::kOk) return odom_from_base * base_from_cam_;
+  // Slightly newer than the last sample (realtime): extrapolate with the last motion.
+  if (r == InterpolationResult::kAfterLast && odometry_.size() >= 2 &&
+      utime - odometry_.last_utime() <= options_.odometry.max_extrapolation_us) {
+    if (odometry_.Extrapolate(utime, &odom_from_base)) return odom_from_base * base_from_cam_;
+  }
+  return std::nullopt;
 }
 
 void PerceptionCore::FillCameraPose(const SlamPose& pose, CameraPoseOutput* out) const {
@@ -264,6 +270,13 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     }
   }
   FillCameraPose(slam_pose, &result.camera_pose);
+  result.world_rescaled_by = map_update.rescaled_by;
+  if (map_update.rescaled_by && result.camera_pose.tracking_state != TrackingState::kNotInitialized) {
+    // This image's pose was computed before the rescale.
+    result.camera_pose.world_from_cam.translation *= *map_update.rescaled_by;
+    result.camera_pose.scale_state = ScaleState::kMetric;
+    result.camera_pose.scale_to_metric = 1.0;
+  }
   if (slam_.map().num_keyframes() > 0 &&
       (map_update.new_keyframe || frame_index_ - last_map_publish_frame_ >= options_.map_publish_every_frames)) {
     result.map = BuildMapOutput(frame.utime);

@@ -56,6 +56,7 @@ struct OdometryOptions {
   double sigma_rotation_floor_rad = 0.002;   // rotation noise floor per image pair (rad)
   double min_depth_m = 0.3;         // nearest plausible static point (flow vector bound) (m)
   double max_depth_m = 0.0;         // farthest plausible static point; 0 = unbounded (m)
+  int64_t max_extrapolation_us = 60000;  // an image newer than the last odometry by at most this is extrapolated (µs)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(sigma_translation_per_m, 0.0);
@@ -64,6 +65,7 @@ struct OdometryOptions {
     MBSLAM_CHECK_OPTION_GT(sigma_rotation_floor_rad, 0.0);
     MBSLAM_CHECK_OPTION_GE(min_depth_m, 0.0);
     MBSLAM_CHECK_OPTION_GE(max_depth_m, 0.0);
+    MBSLAM_CHECK_OPTION_GE(max_extrapolation_us, 0);
     const double n = std::sqrt(base_from_cam_rotation[0] * base_from_cam_rotation[0] +
                                base_from_cam_rotation[1] * base_from_cam_rotation[1] +
                                base_from_cam_rotation[2] * base_from_cam_rotation[2] +
@@ -82,6 +84,7 @@ struct OdometryOptions {
     v("sigma_rotation_floor_rad", &sigma_rotation_floor_rad, "rotation noise floor (rad)");
     v("min_depth_m", &min_depth_m, "nearest plausible static point (m)");
     v("max_depth_m", &max_depth_m, "farthest plausible static point, 0 = unbounded (m)");
+    v("max_extrapolation_us", &max_extrapolation_us, "extrapolate odometry at most this far past its last sample (us)");
   }
 };
 

@@ -143,6 +143,12 @@ void PerceptionPipeline::ProcessImage(const ImageFrame& frame) {
 }
 
 void PerceptionPipeline::ProcessLoop() {
+  // Lockstep: when the log carries odometry, an image waits until odometry covering its
+  // time has been processed (or the next image arrives), so that it is interpolated,
+  // not extrapolated — the same decision on every replay, since it depends only on the
+  // order of the log.
+  std::optional<ImageFrame> pending;
+  int64_t last_odometry_utime = 0;
   while (true) {
     std::optional<FrameEvent> event =
         options_.lockstep() ? frame_queue_.Pop() : frame_queue_.PopFor(20000);
@@ -153,10 +159,25 @@ void PerceptionPipeline::ProcessLoop() {
     }
     if (auto* odom = std::get_if<OdometrySample>(&*event)) {
       processor_->OnOdometry(*odom);
+      last_odometry_utime = std::max(last_odometry_utime, odom->utime);
+      if (pending && last_odometry_utime >= pending->utime) {
+        ProcessImage(*pending);
+        pending.reset();
+      }
       continue;
     }
-    ProcessImage(std::get<ImageFrame>(*event));
+    ImageFrame& frame = std::get<ImageFrame>(*event);
+    if (pending) {
+      ProcessImage(*pending);
+      pending.reset();
+    }
+    if (options_.lockstep() && last_odometry_utime > 0 && last_odometry_utime < frame.utime) {
+      pending = std::move(frame);
+      continue;
+    }
+    ProcessImage(frame);
   }
+  if (pending) ProcessImage(*pending);
 }
 
 std::vector<StageStatus> PerceptionPipeline::RunTimings() const {

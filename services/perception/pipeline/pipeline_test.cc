@@ -74,9 +74,11 @@ TEST(Pipeline, LockstepProcessesEveryEventInOrder) {
   for (int i = 1; i <= 50; ++i) {
     pipeline.Push(Odom(i * 100 - 50));
     expected.push_back("o" + std::to_string(i * 100 - 50));
+    // An image waits for the odometry that covers its time (the next sample).
+    if (i > 1) expected.push_back("i" + std::to_string((i - 1) * 100));
     pipeline.Push(Image(i * 100));
-    expected.push_back("i" + std::to_string(i * 100));
   }
+  expected.push_back("i5000");  // flushed at the end of the stream
   pipeline.Stop();
   EXPECT_EQ(processor.events, expected);
   EXPECT_EQ(sink.utimes.size(), 50u);

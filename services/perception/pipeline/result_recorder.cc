@@ -24,6 +24,13 @@ void ResultRecorder::OnFrameResult(const FrameResult& r) {
   if (frames_ == 0) first_utime_ = r.utime;
   last_utime_ = r.utime;
   ++frames_;
+  if (r.world_rescaled_by) {
+    // Keep the whole trajectory in one unit.
+    for (CameraPoseOutput& p : camera_) p.world_from_cam.translation *= *r.world_rescaled_by;
+    for (auto& [id, poses] : objects_) {
+      for (auto& [utime, pose] : poses) pose.translation *= *r.world_rescaled_by;
+    }
+  }
   const TrackingState s = r.camera_pose.tracking_state;
   if (s == TrackingState::kOk || s == TrackingState::kRelocalized) {
     ++tracked_;

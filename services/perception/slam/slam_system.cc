@@ -481,6 +481,35 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
   CullKeyframes();
 }
 
+std::optional<double> SlamSystem::EstablishMetricScale() {
+  if (metric_ || !options_.use_odometry) return std::nullopt;
+  // The first and the last keyframe with odometry, once they are far enough apart for
+  // the ratio of the two baselines to be reliable.
+  const Keyframe* first = nullptr;
+  const Keyframe* last = nullptr;
+  for (const auto& [id, k] : map_.keyframes()) {
+    if (!k.has_odometry) continue;
+    if (!first) first = &k;
+    last = &k;
+  }
+  if (!first || first == last) return std::nullopt;
+  const double odo = (last->odom_from_cam.Inverse() * first->odom_from_cam).translation.norm();
+  const double slam = (last->cam_from_world * first->cam_from_world.Inverse()).translation.norm();
+  if (odo < options_.metric_min_baseline_m || slam < 1e-9) return std::nullopt;
+  MergeBundleAdjustment(true);
+  const double s = odo / slam;
+  map_.Rescale(s);
+  for (auto& [frame, pose] : recent_poses_) {
+    pose.cam_from_world.translation *= s;
+    pose.covariance.topLeftCorner<3, 3>() *= s * s;
+    pose.covariance.topRightCorner<3, 3>() *= s;
+    pose.covariance.bottomLeftCorner<3, 3>() *= s;
+  }
+  metric_ = true;
+  MBSLAM_LOG(INFO) << "SLAM: metric scale from odometry (x" << s << " over a " << odo << " m baseline)";
+  return s;
+}
+
 void SlamSystem::CullKeyframes() {
   while (static_cast<int>(map_.num_keyframes()) > options_.max_keyframes) {
     auto oldest = map_.keyframes().begin();
@@ -542,6 +571,7 @@ SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered
   if (cur == recent_poses_.end()) return update;
   if (NeedKeyframe(frame, labels)) {
     AddKeyframe(frame, labels, &update);
+    update.rescaled_by = EstablishMetricScale();
     StartBundleAdjustment(static_cast<int>(map_.num_keyframes()) <= options_.ba.global_max_keyframes);
   }
   return update;

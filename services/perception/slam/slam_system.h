@@ -60,6 +60,7 @@ struct SlamOptions {
   int max_keyframes = 200;               // oldest keyframes are culled beyond this (count)
   bool background_ba = true;             // local BA in a back-end thread (realtime); false: inline (deterministic)
   bool use_odometry = true;              // odometry gives the prior motion and the metric scale
+  double metric_min_baseline_m = 0.3;    // odometry baseline needed to fix the metric scale after initialisation (m)
   bool use_segmentation = true;          // feedback from segmentation: moving tracks never enter the map (false = ablation)
   double depth_bound_margin = 0.15;      // known-depth bound: depth * (1 +- margin)
   double frustum_bound_factor = 2.0;     // frustum bound: [min / f, max * f] of map depths around the ray
@@ -87,6 +88,7 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION_GE(max_keyframes, 3);
     MBSLAM_CHECK_OPTION(depth_bound_margin > 0.0 && depth_bound_margin < 1.0);
     MBSLAM_CHECK_OPTION_GT(frustum_bound_factor, 1.0);
+    MBSLAM_CHECK_OPTION_GT(metric_min_baseline_m, 0.0);
     return true;
   }
   template <typename V>
@@ -112,6 +114,7 @@ struct SlamOptions {
     v("max_keyframes", &max_keyframes, "keyframes kept (count)");
     v("background_ba", &background_ba, "local BA in a back-end thread (false: inline, deterministic)");
     v("use_odometry", &use_odometry, "odometry as motion prior and metric scale");
+    v("metric_min_baseline_m", &metric_min_baseline_m, "odometry baseline that fixes the metric scale (m)");
     v("use_segmentation", &use_segmentation, "segmentation feedback: moving tracks stay out of the map (false = ablation)");
     v("depth_bound_margin", &depth_bound_margin, "known-depth bound: depth * (1 +- margin)");
     v("frustum_bound_factor", &frustum_bound_factor, "frustum depth bound: [min / f, max * f]");
@@ -152,8 +155,11 @@ struct SlamPose {
   double scale_to_metric = 0.0;
 };
 
+
+
 struct SlamMapUpdate {
   bool new_keyframe = false;
+  std::optional<double> rescaled_by;       // the map was rescaled by this factor in this image
   std::vector<int64_t> new_point_ids;      // triangulated at this keyframe (occupancy rays)
   std::vector<Eigen::Vector3d> released_points;  // static points whose tracks started moving (object seeds)
   std::vector<int64_t> released_tracks;
@@ -201,6 +207,9 @@ class SlamSystem {
   void StartBundleAdjustment(bool global);
   void MergeBundleAdjustment(bool wait);
   void CullKeyframes();
+  // Without odometry at the initial views, the map becomes metric once two keyframes
+  // with odometry are far enough apart.
+  std::optional<double> EstablishMetricScale();
   std::optional<Rigid3d> PredictPose(const SlamFrame& frame) const;
 
   const SlamOptions options_;

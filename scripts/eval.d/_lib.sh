@@ -1,0 +1,45 @@
+# Shared helpers for the evaluations in scripts/eval.d (sourced, not run).
+
+# sim_sequence SCENARIO [FRAMES] -> prints the sequence folder (generated once, cached).
+sim_sequence() {
+  local scenario="$1" frames="${2:-300}"
+  local dir="$MBSLAM_ROOT/out/sim_cache/${scenario}-${frames}"
+  if [[ ! -f "$dir/sequence.lcmlog" ]]; then
+    rm -rf "$dir"
+    mkdir -p "$(dirname "$dir")"
+    "$MBSLAM_BIN/mbslam-sim" --quiet --scenario "$scenario" --frames "$frames" --out "$dir" >&2
+  fi
+  echo "$dir"
+}
+
+# run_service INPUT_LOG RESULT_DIR [perception_service args...]
+# Lockstep replay; writes RESULT_DIR/{out.lcmlog, result/, service.log}.
+run_service() {
+  local input="$1" result="$2"
+  shift 2
+  mkdir -p "$result"
+  if ! "$MBSLAM_BIN/perception_service" --lcm-url "file://$input?speed=0" --mode lockstep \
+    --output-log "$result/out.lcmlog" --output-dir "$result/result" "$@" 2>"$result/service.log"; then
+    echo "perception_service failed; the end of $result/service.log:" >&2
+    tail -20 "$result/service.log" >&2
+    return 1
+  fi
+}
+
+# path_length TUM_FILE -> metres along the trajectory
+path_length() {
+  awk '!/^#/ && NF >= 8 {if (n++) {dx=$2-x; dy=$3-y; dz=$4-z; L+=sqrt(dx*dx+dy*dy+dz*dz)} x=$2; y=$3; z=$4} END {printf "%.6f\n", L}' "$1"
+}
+
+# last_json CMD... -> runs CMD, echoes its output to stderr, prints its last line
+last_json() {
+  local out
+  out=$("$@")
+  echo "$out" >&2
+  echo "$out" | tail -1
+}
+
+# json_get JSON KEY -> value (python3)
+json_get() {
+  python3 -c 'import json,sys; v=json.loads(sys.argv[1]).get(sys.argv[2]); print("null" if v is None else v)' "$1" "$2"
+}

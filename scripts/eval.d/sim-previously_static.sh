@@ -1,0 +1,5 @@
+#!/usr/bin/env bash
+# Scenario 'previously_static': whole pipeline, camera ATE / path length, fraction tracked, moving-feature segmentation
+set -euo pipefail
+source "$(dirname "$0")/_scenario.sh"
+ABLATION=0 eval_scenario previously_static "${1:-300}"
