@@ -80,11 +80,32 @@ Status SlamSystem::LoadMap(const std::string& path) {
   return Status::Ok();
 }
 
+void SlamSystem::StorePose(int64_t frame, const Rigid3d& T, const Matrix6d& covariance) {
+  FramePose p;
+  p.cam_from_world = T;
+  p.covariance = covariance;
+  if (const Keyframe* kf = map_.LastKeyframe()) {
+    p.anchor_keyframe = kf->id;
+    p.cam_from_anchor = T * kf->cam_from_world.Inverse();
+  }
+  recent_poses_[frame] = p;
+  while (recent_poses_.size() > 64) recent_poses_.erase(recent_poses_.begin());
+}
+
+std::optional<Rigid3d> SlamSystem::PoseOf(int64_t frame) const {
+  auto it = recent_poses_.find(frame);
+  if (it == recent_poses_.end()) return std::nullopt;
+  if (const Keyframe* kf = map_.keyframe(it->second.anchor_keyframe)) {
+    return it->second.cam_from_anchor * kf->cam_from_world;
+  }
+  return it->second.cam_from_world;
+}
+
 std::optional<Rigid3d> SlamSystem::PredictPose(const SlamFrame& frame) const {
   if (recent_poses_.empty()) return std::nullopt;
   auto last = recent_poses_.rbegin();
   const int64_t a = last->first;
-  const Rigid3d& Ta = last->second.cam_from_world;
+  const Rigid3d Ta = *PoseOf(a);
   // Odometry: the camera motion since frame a (metric map: directly; otherwise the
   // rotation only, translation from constant velocity below).
   std::optional<Rigid3d> odo_delta;
@@ -96,7 +117,7 @@ std::optional<Rigid3d> SlamSystem::PredictPose(const SlamFrame& frame) const {
   if (recent_poses_.size() < 2) return odo_delta ? Rigid3d(odo_delta->rotation, Eigen::Vector3d::Zero()) * Ta : Ta;
   auto prev = std::next(last);
   const int64_t b = prev->first;
-  const Vector6d xi = (Ta * prev->second.cam_from_world.Inverse()).Log() / static_cast<double>(a - b);
+  const Vector6d xi = (Ta * PoseOf(b)->Inverse()).Log() / static_cast<double>(a - b);
   return Rigid3d::Exp(xi * static_cast<double>(frame.frame_index - a)) * Ta;
 }
 
@@ -119,7 +140,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   std::vector<Eigen::Vector2d> xy;
   std::vector<int64_t> tracks;
   for (const SlamObservation& o : frame.observations) {
-    if (o.body_id > 0) continue;
+    if (o.body_id != 0) continue;  // only tracks segmentation holds static
     const int64_t pid = map_.PointOfTrack(o.track_id);
     if (pid < 0) continue;
     const MapPoint* p = map_.point(pid);
@@ -154,7 +175,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     out.covariance = est.covariance;
     out.num_inliers = est.num_inliers;
     last_inliers_ = est.num_inliers;
-    recent_poses_[frame.frame_index] = FramePose{est.cam_from_world, est.covariance};
+    StorePose(frame.frame_index, est.cam_from_world, est.covariance);
     for (size_t i = 0; i < tracks.size(); ++i) {
       const int64_t pid = map_.PointOfTrack(tracks[i]);
       MapPoint* p = map_.point(pid);
@@ -181,7 +202,6 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
       }
     }
   }
-  while (recent_poses_.size() > 64) recent_poses_.erase(recent_poses_.begin());
   out.state = state_;
   out.metric = metric_;
   out.scale_to_metric = metric_ ? 1.0 : 0.0;
@@ -193,7 +213,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   out->state = state_;
   std::unordered_map<int64_t, Eigen::Vector2d> current;
   for (const SlamObservation& o : frame.observations) {
-    if (o.body_id <= 0) current[o.track_id] = o.xy;
+    if (o.body_id == 0) current[o.track_id] = o.xy;  // segmented static only
   }
   auto set_reference = [&]() {
     if (static_cast<int>(current.size()) < options_.init_min_tracks) {
@@ -343,7 +363,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   k1.cam_from_world = Rigid3d(best->T.rotation, best->T.translation * scale);
   k1.track_xy = current;
   for (const SlamObservation& o : frame.observations) {
-    if (o.body_id <= 0) k1.track_uv[o.track_id] = o.uv;
+    if (o.body_id == 0) k1.track_uv[o.track_id] = o.uv;
   }
   if (frame.odom_from_cam) {
     k1.has_odometry = true;
@@ -368,8 +388,18 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   if (s.usable) ApplyBaResult(problem, options_.ba, &map_);
   ++ba_runs_;
   const Keyframe& kf1 = *map_.keyframe(id1);
-  recent_poses_[init_ref_frame_] = FramePose{Rigid3d(), Matrix6d::Identity() * 1e-6};
-  recent_poses_[frame.frame_index] = FramePose{kf1.cam_from_world, Matrix6d::Identity() * 1e-4};
+  // Covariances of the two views: small (a few hundredths of a pixel-equivalent).
+  const Matrix6d init_cov = Matrix6d::Identity() * std::pow(0.5 / frame.focal_px, 2);
+  FramePose p0;
+  p0.cam_from_world = Rigid3d();
+  p0.covariance = init_cov;
+  p0.anchor_keyframe = id0;
+  recent_poses_[init_ref_frame_] = p0;
+  FramePose p1;
+  p1.cam_from_world = kf1.cam_from_world;
+  p1.covariance = init_cov;
+  p1.anchor_keyframe = id1;
+  recent_poses_[frame.frame_index] = p1;
   last_keyframe_frame_ = frame.frame_index;
   tracked_points_at_keyframe_ = static_cast<int>(map_.num_points());
   state_ = options_.init_confirm_frames > 0 ? SlamState::kConfirming : SlamState::kTracking;
@@ -394,10 +424,10 @@ bool SlamSystem::NeedKeyframe(const SlamFrame& frame, const std::unordered_map<i
   if (last_inliers_ < options_.keyframe_tracked_ratio * tracked_points_at_keyframe_) return true;
   // Parallax to the last keyframe (rotation compensated, via the poses).
   const Keyframe* kf = map_.LastKeyframe();
-  auto cur = recent_poses_.find(frame.frame_index);
-  if (!kf || cur == recent_poses_.end()) return false;
+  const std::optional<Rigid3d> cur = PoseOf(frame.frame_index);
+  if (!kf || !cur) return false;
   const Eigen::Matrix3d Rk = kf->cam_from_world.RotationMatrix().transpose();
-  const Eigen::Matrix3d Rc = cur->second.cam_from_world.RotationMatrix().transpose();
+  const Eigen::Matrix3d Rc = cur->RotationMatrix().transpose();
   std::vector<double> angles;
   for (const SlamObservation& o : frame.observations) {
     auto it = kf->track_xy.find(o.track_id);
@@ -411,7 +441,7 @@ bool SlamSystem::NeedKeyframe(const SlamFrame& frame, const std::unordered_map<i
 
 void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels,
                              SlamMapUpdate* update) {
-  const Rigid3d T = recent_poses_.at(frame.frame_index).cam_from_world;
+  const Rigid3d T = *PoseOf(frame.frame_index);
   Keyframe kf;
   kf.frame_index = frame.frame_index;
   kf.utime = frame.utime;
@@ -501,6 +531,7 @@ std::optional<double> SlamSystem::EstablishMetricScale() {
   map_.Rescale(s);
   for (auto& [frame, pose] : recent_poses_) {
     pose.cam_from_world.translation *= s;
+    pose.cam_from_anchor.translation *= s;
     pose.covariance.topLeftCorner<3, 3>() *= s * s;
     pose.covariance.topRightCorner<3, 3>() *= s;
     pose.covariance.bottomLeftCorner<3, 3>() *= s;
@@ -548,8 +579,8 @@ SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered
       map_.ReleaseTrack(o.track_id);
     }
   }
-  auto cur = recent_poses_.find(frame.frame_index);
-  if (cur != recent_poses_.end() && !frame.moving_hulls_xy.empty()) {
+  const std::optional<Rigid3d> cur = PoseOf(frame.frame_index);
+  if (cur && !frame.moving_hulls_xy.empty()) {
     // Points of the recent keyframes behind a moving hull are occluded, not lost.
     std::set<int64_t> recent;
     int n = 0;
@@ -559,7 +590,7 @@ SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered
     for (int64_t pid : recent) {
       MapPoint* p = map_.point(pid);
       if (!p || p->track_id >= 0) continue;
-      const Eigen::Vector3d pc = cur->second.cam_from_world * p->position;
+      const Eigen::Vector3d pc = *cur * p->position;
       if (pc.z() <= 0) continue;
       const Eigen::Vector2f xy = pc.hnormalized().cast<float>();
       bool inside = false;
@@ -568,7 +599,7 @@ SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered
     }
   }
   if (state_ != SlamState::kTracking && state_ != SlamState::kConfirming) return update;
-  if (cur == recent_poses_.end()) return update;
+  if (!cur) return update;
   if (NeedKeyframe(frame, labels)) {
     AddKeyframe(frame, labels, &update);
     update.rescaled_by = EstablishMetricScale();
@@ -613,7 +644,7 @@ std::optional<RelativeMotion> SlamSystem::RelativeMotionBetween(int64_t ref, int
   auto n = recent_poses_.find(cur);
   if (r == recent_poses_.end() || n == recent_poses_.end() || !initialized()) return std::nullopt;
   RelativeMotion m;
-  m.cam_n_from_cam_r = n->second.cam_from_world * r->second.cam_from_world.Inverse();
+  m.cam_n_from_cam_r = *PoseOf(cur) * PoseOf(ref)->Inverse();
   const Matrix6d ad = m.cam_n_from_cam_r.Adjoint();
   m.covariance = n->second.covariance + ad * r->second.covariance * ad.transpose();
   m.translation_known = m.cam_n_from_cam_r.translation.norm() > 1e-9;
@@ -652,9 +683,9 @@ const SlamSystem::DepthGrid& SlamSystem::GridFor(int64_t frame, const Rigid3d& T
 
 DepthBound SlamSystem::DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const {
   DepthBound bound;
-  auto r = recent_poses_.find(frame);
-  if (r == recent_poses_.end() || !initialized()) return bound;
-  const Rigid3d& T = r->second.cam_from_world;
+  const std::optional<Rigid3d> pose = PoseOf(frame);
+  if (!pose || !initialized()) return bound;
+  const Rigid3d T = *pose;
   const int64_t pid = map_.PointOfTrack(track_id);
   if (pid >= 0) {
     const double z = (T * map_.point(pid)->position).z();

@@ -224,11 +224,19 @@ class SlamSystem {
   int confirm_count_ = 0;
 
   // Recent camera poses (frame index -> pose, covariance) for segmentation.
+  // Poses are kept relative to a keyframe (the anchor), so that when bundle adjustment
+  // moves the keyframes, the recent frames move with them and relative motions between
+  // a frame before and a frame after an adjustment stay consistent.
   struct FramePose {
-    Rigid3d cam_from_world;
+    Rigid3d cam_from_world;     // as estimated (fallback when the anchor is gone)
     Matrix6d covariance;
+    int64_t anchor_keyframe = -1;
+    Rigid3d cam_from_anchor;    // cam_from_world * anchor.cam_from_world^-1
   };
   std::map<int64_t, FramePose> recent_poses_;
+  void StorePose(int64_t frame, const Rigid3d& cam_from_world, const Matrix6d& covariance);
+  // The current estimate of a recent frame's pose (following its anchor keyframe).
+  std::optional<Rigid3d> PoseOf(int64_t frame) const;
   std::map<int64_t, Rigid3d> recent_odometry_;  // frame -> odom_from_cam
   int64_t last_frame_ = -1;
   int lost_frames_ = 0;

@@ -1,0 +1,268 @@
+#include "services/perception/occupancy/occupancy_map.h"
+
+#include <octomap/OcTree.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "common/util/atomic_file.h"
+#include "common/util/logging.h"
+
+namespace mbslam {
+namespace {
+
+// Shortest ray that is still a measurement (map units): an end point at the camera
+// centre has no direction.
+constexpr double kMinRayLength = 1e-9;
+
+octomap::point3d ToOcto(const Eigen::Vector3d& p) {
+  return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                          static_cast<float>(p.z()));
+}
+
+}  // namespace
+
+const char* OccupancyUnitsName(OccupancyMap::Units units) {
+  return units == OccupancyMap::Units::kMetres ? "metres" : "up-to-scale";
+}
+
+OccupancyMap::OccupancyMap(const OccupancyMapOptions& options, Units units)
+    : options_(options), units_(units) {
+  if (!options_.Check()) {
+    MBSLAM_LOG(WARNING) << "occupancy: " << LastOptionError() << "; using the defaults";
+    options_ = OccupancyMapOptions();
+  }
+  if (units_ == Units::kMetres || options_.resolution_depth_fraction <= 0.0) {
+    double resolution = 0.0, max_range = 0.0;
+    MetricResolution(&resolution, &max_range);
+    Rebuild(resolution, max_range);
+  }
+}
+
+OccupancyMap::~OccupancyMap() = default;
+
+void OccupancyMap::MetricResolution(double* resolution, double* max_range) const {
+  *resolution = options_.resolution_m;
+  *max_range = options_.max_range_m > 0.0 ? options_.max_range_m : -1.0;
+}
+
+double OccupancyMap::resolution() const { return tree_ ? tree_->getResolution() : 0.0; }
+
+OccupancyInsertSummary OccupancyMap::InsertRays(
+    const Eigen::Vector3d& camera_center_in_world,
+    const std::vector<Eigen::Vector3d>& points_in_world) {
+  OccupancyInsertSummary summary;
+  if (!camera_center_in_world.allFinite()) {
+    summary.rays_rejected = static_cast<int>(points_in_world.size());
+    return summary;
+  }
+  RayBatch batch;
+  batch.origin = camera_center_in_world;
+  batch.ends.reserve(points_in_world.size());
+  for (const Eigen::Vector3d& p : points_in_world) {
+    if (!p.allFinite() || (p - camera_center_in_world).norm() < kMinRayLength) {
+      ++summary.rays_rejected;
+      continue;
+    }
+    batch.ends.push_back(p.cast<float>());
+  }
+  if (batch.ends.empty()) return summary;
+
+  if (!tree_) {
+    // Up to scale, resolution not fixed yet: collect rays until their median length
+    // is known, then build the tree from all of them.
+    summary.rays_buffered = static_cast<int>(batch.ends.size());
+    batches_.push_back(std::move(batch));
+    stored_rays_ += summary.rays_buffered;
+    if (stored_rays_ >= options_.min_rays_for_resolution) {
+      const double median = MedianStoredRayLength();
+      const double resolution = options_.resolution_depth_fraction * median;
+      const double max_range = options_.max_range_depth_multiple > 0.0
+                                   ? options_.max_range_depth_multiple * median
+                                   : (options_.max_range_m > 0.0 ? options_.max_range_m : -1.0);
+      if (resolution > 0.0 && std::isfinite(resolution)) {
+        MBSLAM_LOG(INFO) << "occupancy: median ray length " << median
+                         << " map units: voxel edge " << resolution << ", range bound "
+                         << max_range;
+        Rebuild(resolution, max_range);
+        summary.rays_inserted = static_cast<int>(stored_rays_);
+        StoreBatch(RayBatch());  // applies the bound on stored rays
+        ++revision_;
+      }
+    }
+    return summary;
+  }
+
+  InsertBatch(batch, &summary);
+  if (options_.max_stored_rays > 0) StoreBatch(std::move(batch));
+  ++revision_;
+  num_occupied_cache_.reset();
+  return summary;
+}
+
+void OccupancyMap::InsertBatch(const RayBatch& batch, OccupancyInsertSummary* summary) {
+  const octomap::point3d origin = ToOcto(batch.origin);
+  octomap::OcTreeKey key;
+  if (!tree_->coordToKeyChecked(origin, key)) {
+    summary->rays_rejected += static_cast<int>(batch.ends.size());
+    return;
+  }
+  octomap::Pointcloud cloud;
+  cloud.reserve(batch.ends.size());
+  const Eigen::Vector3f origin_f = batch.origin.cast<float>();
+  for (const Eigen::Vector3f& end : batch.ends) {
+    const Eigen::Vector3f ray = end - origin_f;
+    const float length = ray.norm();
+    Eigen::Vector3f last = end;  // the farthest point the ray updates
+    const bool truncated = max_range_ > 0.0 && length > max_range_;
+    if (truncated) last = origin_f + ray * static_cast<float>(max_range_ / length);
+    if (!tree_->coordToKeyChecked(octomap::point3d(last.x(), last.y(), last.z()), key)) {
+      ++summary->rays_rejected;  // outside the tree's coordinate range
+      continue;
+    }
+    if (truncated) ++summary->rays_truncated;
+    cloud.push_back(end.x(), end.y(), end.z());
+  }
+  if (cloud.size() == 0) return;
+  tree_->insertPointCloud(cloud, origin, max_range_, /*lazy_eval=*/false, options_.discretize);
+  summary->rays_inserted += static_cast<int>(cloud.size());
+}
+
+void OccupancyMap::StoreBatch(RayBatch batch) {
+  stored_rays_ += static_cast<int64_t>(batch.ends.size());
+  if (!batch.ends.empty()) batches_.push_back(std::move(batch));
+  while (!batches_.empty() && stored_rays_ > options_.max_stored_rays) {
+    const int64_t n = static_cast<int64_t>(batches_.front().ends.size());
+    stored_rays_ -= n;
+    rays_forgotten_ += n;
+    batches_.pop_front();
+  }
+}
+
+double OccupancyMap::MedianStoredRayLength() const {
+  std::vector<double> lengths;
+  lengths.reserve(static_cast<size_t>(stored_rays_));
+  for (const RayBatch& batch : batches_) {
+    const Eigen::Vector3f origin = batch.origin.cast<float>();
+    for (const Eigen::Vector3f& end : batch.ends) lengths.push_back((end - origin).norm());
+  }
+  if (lengths.empty()) return 0.0;
+  auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+  std::nth_element(lengths.begin(), mid, lengths.end());
+  return *mid;
+}
+
+void OccupancyMap::Rebuild(double resolution, double max_range) {
+  tree_ = std::make_unique<octomap::OcTree>(resolution);
+  tree_->setProbHit(options_.prob_hit);
+  tree_->setProbMiss(options_.prob_miss);
+  tree_->setClampingThresMin(options_.clamping_min);
+  tree_->setClampingThresMax(options_.clamping_max);
+  tree_->setOccupancyThres(options_.occupancy_threshold);
+  max_range_ = max_range;
+  OccupancyInsertSummary ignored;
+  for (const RayBatch& batch : batches_) InsertBatch(batch, &ignored);
+  num_occupied_cache_.reset();
+}
+
+Status OccupancyMap::Rescale(double factor, Units units) {
+  if (!std::isfinite(factor) || factor <= 0.0) {
+    return Status::Error("occupancy: rescale factor must be finite and > 0 (got " +
+                         std::to_string(factor) + ")");
+  }
+  const float f = static_cast<float>(factor);
+  for (RayBatch& batch : batches_) {
+    batch.origin *= factor;
+    for (Eigen::Vector3f& end : batch.ends) end *= f;
+  }
+  units_ = units;
+  if (units == Units::kMetres) {
+    double resolution = 0.0, max_range = 0.0;
+    MetricResolution(&resolution, &max_range);
+    Rebuild(resolution, max_range);
+  } else if (tree_) {
+    Rebuild(tree_->getResolution() * factor, max_range_ > 0.0 ? max_range_ * factor : max_range_);
+  }
+  if (tree_) StoreBatch(RayBatch());  // the bound applies once the tree exists
+  ++revision_;
+  return Status::Ok();
+}
+
+Status OccupancyMap::Serialize(std::string* binary) const {
+  if (!tree_) {
+    return Status::Error("occupancy: map not started yet (" + std::to_string(stored_rays_) +
+                         " of " + std::to_string(options_.min_rays_for_resolution) +
+                         " rays needed to fix the voxel size of an up-to-scale map)");
+  }
+  // writeBinary converts to maximum likelihood and prunes in place: do it on a copy.
+  octomap::OcTree copy(*tree_);
+  std::ostringstream out(std::ios::out | std::ios::binary);
+  if (!copy.writeBinary(out) || !out) return Status::Error("occupancy: writeBinary failed");
+  *binary = out.str();
+  return Status::Ok();
+}
+
+Status OccupancyMap::SaveBt(const std::string& path) const {
+  std::string binary;
+  MBSLAM_RETURN_IF_ERROR(Serialize(&binary));
+  return WriteStringAtomically(path, binary).WithContext("occupancy: writing " + path);
+}
+
+int64_t OccupancyMap::NumOccupied() const {
+  if (!tree_) return 0;
+  if (num_occupied_cache_) return *num_occupied_cache_;
+  const unsigned max_depth = tree_->getTreeDepth();
+  int64_t count = 0;
+  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
+    if (tree_->isNodeOccupied(*it)) count += int64_t{1} << (3 * (max_depth - it.getDepth()));
+  }
+  num_occupied_cache_ = count;
+  return count;
+}
+
+std::optional<double> OccupancyMap::Occupancy(const Eigen::Vector3d& point_in_world) const {
+  if (!tree_ || !point_in_world.allFinite()) return std::nullopt;
+  octomap::OcTreeKey key;
+  if (!tree_->coordToKeyChecked(ToOcto(point_in_world), key)) return std::nullopt;
+  const octomap::OcTreeNode* node = tree_->search(key);
+  if (!node) return std::nullopt;
+  return node->getOccupancy();
+}
+
+bool OccupancyMap::IsOccupied(const Eigen::Vector3d& point_in_world) const {
+  if (!tree_ || !point_in_world.allFinite()) return false;
+  octomap::OcTreeKey key;
+  if (!tree_->coordToKeyChecked(ToOcto(point_in_world), key)) return false;
+  const octomap::OcTreeNode* node = tree_->search(key);
+  return node != nullptr && tree_->isNodeOccupied(node);
+}
+
+std::vector<Eigen::Vector3d> OccupancyMap::OccupiedVoxelCenters() const {
+  std::vector<Eigen::Vector3d> centers;
+  if (!tree_) return centers;
+  const double res = tree_->getResolution();
+  const unsigned max_depth = tree_->getTreeDepth();
+  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
+    if (!tree_->isNodeOccupied(*it)) continue;
+    const octomap::point3d c = it.getCoordinate();
+    const Eigen::Vector3d center(c.x(), c.y(), c.z());
+    const int n = 1 << (max_depth - it.getDepth());  // voxels per edge of this leaf
+    if (n == 1) {
+      centers.push_back(center);
+      continue;
+    }
+    const Eigen::Vector3d corner = center - Eigen::Vector3d::Constant(0.5 * n * res);
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        for (int k = 0; k < n; ++k) {
+          centers.push_back(corner + res * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5));
+        }
+      }
+    }
+  }
+  return centers;
+}
+
+}  // namespace mbslam
