@@ -31,12 +31,14 @@ path_length() {
   awk '!/^#/ && NF >= 8 {if (n++) {dx=$2-x; dy=$3-y; dz=$4-z; L+=sqrt(dx*dx+dy*dy+dz*dz)} x=$2; y=$3; z=$4} END {printf "%.6f\n", L}' "$1"
 }
 
-# last_json CMD... -> runs CMD, echoes its output to stderr, prints its last line
+# last_json CMD... -> runs CMD, echoes its output to stderr, prints its last line if it
+# is a JSON object, else {} (a metric that could not be computed is reported as missing)
 last_json() {
-  local out
-  out=$("$@")
+  local out line
+  out=$("$@" 2>&1) || true
   echo "$out" >&2
-  echo "$out" | tail -1
+  line=$(echo "$out" | tail -1)
+  if [[ "$line" == "{"* ]]; then echo "$line"; else echo "{}"; fi
 }
 
 # json_get JSON KEY -> value (python3)

@@ -23,8 +23,9 @@ eval_scenario() {
 import json, sys
 name, ate, seg, ate_nf, length = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3]), json.loads(sys.argv[4]), float(sys.argv[5])
 summary = json.load(open(sys.argv[6]))
+rmse = ate.get("ate_rmse_m")
 out = {"scenario": name, "path_length_m": length,
-       "ate_rmse_m": ate.get("ate_rmse_m"), "ate_rel_path": ate["ate_rmse_m"] / length if length > 0 else None,
+       "ate_rmse_m": rmse, "ate_rel_path": rmse / length if (rmse is not None and length > 0) else None,
        "tracked_fraction": ate.get("fraction_tracked"), "sim3_scale": ate.get("scale"),
        "moving_recall": seg.get("moving_recall"), "moving_precision": seg.get("moving_precision"),
        "false_moving_fraction": seg.get("false_moving_fraction"),
@@ -32,12 +33,14 @@ out = {"scenario": name, "path_length_m": length,
        "detection_delay_frames": seg.get("detection_delay_frames"),
        "timings_ms": {k: v.get("mean_ms") for k, v in summary.get("timings", {}).items()}}
 if ate_nf:
-    out["ate_rel_path_no_feedback"] = ate_nf["ate_rmse_m"] / length if length > 0 else None
+    out["ate_rel_path_no_feedback"] = ate_nf["ate_rmse_m"] / length if ("ate_rmse_m" in ate_nf and length > 0) else None
     out["tracked_fraction_no_feedback"] = ate_nf.get("fraction_tracked")
-print(f"sim-{name}: ATE {100*out['ate_rel_path']:.3f} % of {length:.2f} m, tracked {100*out['tracked_fraction']:.1f} %, "
+def pct(v):
+    return "n/a" if v is None else f"{100*v:.3f} %"
+print(f"sim-{name}: ATE {pct(out['ate_rel_path'])} of {length:.2f} m, tracked {pct(out['tracked_fraction'])}, "
       f"moving recall {out['moving_recall']}, precision {out['moving_precision']}, false moving {out['false_moving_fraction']}")
 if ate_nf:
-    print(f"  without segmentation feedback: ATE {100*out['ate_rel_path_no_feedback']:.3f} %, tracked {100*out['tracked_fraction_no_feedback']:.1f} %")
+    print(f"  without segmentation feedback: ATE {pct(out.get('ate_rel_path_no_feedback'))}, tracked {pct(out.get('tracked_fraction_no_feedback'))}")
 print(json.dumps(out))
 PY
 }

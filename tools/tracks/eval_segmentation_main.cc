@@ -128,6 +128,11 @@ int Run(int argc, char** argv) {
       scored = true;
       tp += truly_moving && labelled_moving;
       fp += !truly_moving && labelled_moving;
+      if (std::getenv("EVAL_DUMP_FN") && truly_moving && !labelled_moving) {
+        std::printf("FN frame %lld id %lld uv %.0f %.0f body %d mask %d p %.3f epi %.2f fvb %.3f age %d\n",
+                    static_cast<long long>(t.frame_seq), static_cast<long long>(f.id), f.u, f.v, f.body_id,
+                    body, f.p_static, f.epipolar_px, f.fvb, f.age);
+      }
       if (std::getenv("EVAL_DUMP_FP") && !truly_moving && labelled_moving) {
         std::printf("FP frame %lld id %lld uv %.0f %.0f body %d mask %d p %.3f epi %.2f fvb %.3f age %d dist %.1f\n",
                     static_cast<long long>(t.frame_seq), static_cast<long long>(f.id), f.u, f.v, f.body_id,

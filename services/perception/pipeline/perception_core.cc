@@ -189,6 +189,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     o.uv = t.uv.cast<double>();
     o.xy = intrinsics.PixelToNormalized(o.uv);
     o.body_id = options_.slam.use_segmentation ? t.body_id : 0;
+    o.p_static = options_.slam.use_segmentation ? t.p_static : 1.0;
     o.is_new = t.is_new;
     slam_frame.observations.push_back(o);
   }

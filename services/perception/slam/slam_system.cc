@@ -213,7 +213,8 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   out->state = state_;
   std::unordered_map<int64_t, Eigen::Vector2d> current;
   for (const SlamObservation& o : frame.observations) {
-    if (o.body_id == 0) current[o.track_id] = o.xy;  // segmented static only
+    // Static, or not yet judged (new) and not believed moving; movers stay out.
+    if (o.body_id == 0 || (o.body_id < 0 && o.p_static >= 0.5)) current[o.track_id] = o.xy;
   }
   auto set_reference = [&]() {
     if (static_cast<int>(current.size()) < options_.init_min_tracks) {
@@ -363,7 +364,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   k1.cam_from_world = Rigid3d(best->T.rotation, best->T.translation * scale);
   k1.track_xy = current;
   for (const SlamObservation& o : frame.observations) {
-    if (o.body_id == 0) k1.track_uv[o.track_id] = o.uv;
+    if (current.count(o.track_id)) k1.track_uv[o.track_id] = o.uv;
   }
   if (frame.odom_from_cam) {
     k1.has_odometry = true;

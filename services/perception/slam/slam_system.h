@@ -128,6 +128,7 @@ struct SlamObservation {
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // normalised
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // px
   int body_id = -1;        // label from the previous segmentation (0 static)
+  double p_static = 0.5;   // segmentation's P(static) for the track
   bool is_new = false;
 };
 

@@ -1,0 +1,835 @@
+#include "services/perception/objects/bearing_only_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "common/util/logging.h"
+
+namespace mbslam {
+namespace {
+
+constexpr double kUsToS = 1e-6;
+// Log-weight of a particle that cannot be measured at all (behind the camera).
+constexpr double kUnmeasurableLogWeight = -1e6;
+// Cells of the numeric integration over the free depth when velocities are seated.
+constexpr int kSeatCells = 16;
+
+Eigen::Vector3d Normal3(ParticleRng* rng) {
+  return Eigen::Vector3d(rng->Normal(), rng->Normal(), rng->Normal());
+}
+
+// Removes the component along the unit vector n.
+Eigen::Vector3d InPlane(const Eigen::Vector3d& v, const Eigen::Vector3d& n) {
+  return v - v.dot(n) * n;
+}
+
+// Linear-interpolated percentile of sorted values, q in [0, 1].
+double SortedPercentile(const std::vector<double>& sorted, double q) {
+  const double pos = q * static_cast<double>(sorted.size() - 1);
+  const size_t i = static_cast<size_t>(std::floor(pos));
+  const size_t j = std::min(i + 1, sorted.size() - 1);
+  const double f = pos - static_cast<double>(i);
+  return sorted[i] * (1.0 - f) + sorted[j] * f;
+}
+
+uint64_t MixSeed(int64_t seed, int64_t object_id) {
+  uint64_t x = static_cast<uint64_t>(seed) * 0x9e3779b97f4a7c15ULL;
+  x ^= static_cast<uint64_t>(object_id) + 0x632be59bd9b4e019ULL + (x << 6) + (x >> 2);
+  return x;
+}
+
+bool FiniteGroundPlane(const std::optional<GroundPlane>& plane) {
+  return plane && plane->IsValid();
+}
+
+}  // namespace
+
+// The cue set psi of one step, evaluated for the step's image.
+struct BearingOnlyTracker::StepCues {
+  bool has_camera = false;  // depth-based checks need the image's camera
+  Eigen::Matrix3d R_cw = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t_cw = Eigen::Vector3d::Zero();
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // camera centre, world
+  double min_depth = 0.0;
+  bool depth = false;  // depth bound
+  double z_min = 0.0, z_max = 0.0;
+  bool has_plane = false;  // the ground plane is known (ground-plane and size-bound cues)
+  GroundPlane plane;
+  bool ground = false;  // ground-plane cue
+  double height_tolerance = 0.0;
+  double below_tolerance = 0.0;
+  bool size = false;  // size bound: lowest track height = h_cam + z k_lo (with the plane)
+  double h_cam = 0.0, k_lo = 0.0, k_hi = 0.0;
+  double max_clearance = 0.0, max_height = 0.0;
+
+  double Depth(const Eigen::Vector3d& p) const { return R_cw.row(2).dot(p) + t_cw.z(); }
+};
+
+BearingOnlyTracker::BearingOnlyTracker(const BearingOnlyTrackerOptions& options,
+                                       int64_t object_id)
+    : options_(options),
+      options_ok_(options.Check()),
+      object_id_(object_id),
+      rng_(MixSeed(options.seed, object_id)) {}
+
+void BearingOnlyTracker::Reset() {
+  rng_.Seed(MixSeed(options_.seed, object_id_));
+  particles_.clear();
+  initialized_ = false;
+  seated_ = false;
+  orientation_tracked_ = false;
+  utime_ = 0;
+  init_utime_ = 0;
+  plane_.reset();
+  sfm_history_.clear();
+  stats_ = BotStats();
+}
+
+Status BearingOnlyTracker::CheckObservation(const BotObservation& o) const {
+  if (!options_ok_) return Status::Error("bearing-only tracker options: " + LastOptionError());
+  if (!o.cam_from_world.IsFinite()) return Status::Error("camera pose not finite");
+  if (!o.xy.allFinite()) return Status::Error("bearing not finite");
+  if (!(o.focal_px > 0.0) || !std::isfinite(o.focal_px)) {
+    return Status::Error("focal length must be positive");
+  }
+  if (!std::isfinite(o.bearing_sigma_px) || o.bearing_sigma_px < 0.0) {
+    return Status::Error("bearing sigma must be finite and >= 0");
+  }
+  if (o.depth_bound && (std::isnan(o.depth_bound->min) || std::isnan(o.depth_bound->max) ||
+                        o.depth_bound->max < o.depth_bound->min)) {
+    return Status::Error("depth bound is NaN or empty");
+  }
+  if (o.sfm && (!o.sfm->cam_from_obj.IsFinite() || !o.sfm->reference_in_obj.allFinite())) {
+    return Status::Error("SfM observation not finite");
+  }
+  return Status::Ok();
+}
+
+BearingOnlyTracker::StepCues BearingOnlyTracker::MakeCues(const BotObservation* o) const {
+  StepCues c;
+  c.min_depth = options_.min_depth;
+  c.height_tolerance = options_.ground_height_tolerance;
+  c.below_tolerance = options_.below_ground_tolerance;
+  c.max_clearance = options_.max_ground_clearance;
+  c.max_height = options_.max_object_height;
+  const std::optional<GroundPlane>& plane =
+      (o != nullptr && FiniteGroundPlane(o->ground_plane)) ? o->ground_plane : plane_;
+  if (FiniteGroundPlane(plane)) {
+    c.has_plane = true;
+    c.plane = *plane;
+    c.ground = options_.cues.ground_plane;
+  }
+  if (o == nullptr) return c;
+
+  c.has_camera = true;
+  c.R_cw = o->cam_from_world.RotationMatrix();
+  c.t_cw = o->cam_from_world.translation;
+  c.center = -c.R_cw.transpose() * c.t_cw;
+  if (options_.cues.depth_bound && o->depth_bound) {
+    c.depth = true;
+    c.z_min = o->depth_bound->min;
+    c.z_max = o->depth_bound->max;
+  }
+  if (options_.cues.size_bound &&
+      static_cast<int>(o->track_xy.size()) >= options_.size_bound_min_tracks) {
+    // Height of track j at camera depth z: h_cam + z k_j, with k_j = up . R_wc [x_j; y_j; 1]
+    // (up = the plane's normal, or the camera's -y axis without a plane: then only the
+    // object's height is bounded).
+    const Eigen::Matrix3d R_wc = c.R_cw.transpose();
+    const Eigen::Vector3d up = c.has_plane ? c.plane.normal : Eigen::Vector3d(-R_wc.col(1));
+    std::vector<double> k;
+    k.reserve(o->track_xy.size());
+    for (const Eigen::Vector2d& xy : o->track_xy) {
+      if (xy.allFinite()) k.push_back(up.dot(R_wc * xy.homogeneous()));
+    }
+    if (static_cast<int>(k.size()) >= options_.size_bound_min_tracks) {
+      std::sort(k.begin(), k.end());
+      c.size = true;
+      c.k_lo = SortedPercentile(k, options_.size_bound_percentile);
+      c.k_hi = SortedPercentile(k, 1.0 - options_.size_bound_percentile);
+      c.h_cam = c.has_plane ? c.plane.Height(c.center) : 0.0;
+    }
+  }
+  return c;
+}
+
+bool BearingOnlyTracker::InPsi(const BotParticle& particle, const StepCues& c) const {
+  double z = 0.0;
+  if (c.has_camera) {
+    z = c.Depth(particle.position);
+    if (z < c.min_depth) return false;
+    if (c.depth && (z < c.z_min || z > c.z_max)) return false;
+  }
+  if (c.ground) {
+    const double h = c.plane.Height(particle.position);
+    if (std::abs(h - particle.ground_height) > c.height_tolerance) return false;
+    if (h < -c.below_tolerance) return false;
+  }
+  if (c.size && c.has_camera) {
+    if (c.has_plane) {
+      const double lowest = c.h_cam + z * c.k_lo;
+      if (lowest < -c.below_tolerance || lowest > c.max_clearance) return false;
+    }
+    if (z * (c.k_hi - c.k_lo) > c.max_height) return false;
+  }
+  return true;
+}
+
+void BearingOnlyTracker::DrawInitialVelocity(BotParticle* particle, const StepCues& c) {
+  const double speed = rng_.Uniform(options_.init_speed_min, options_.init_speed_max);
+  Eigen::Vector3d direction = Normal3(&rng_);
+  if (c.ground) direction = InPlane(direction, c.plane.normal);
+  const double n = direction.norm();
+  particle->linear_velocity = n > 1e-12 ? Eigen::Vector3d(speed * direction / n)
+                                        : Eigen::Vector3d::Zero();
+  particle->angular_velocity.setZero();
+}
+
+Status BearingOnlyTracker::Initialize(const BotObservation& observation) {
+  return InitializeImpl(observation, nullptr, 0.0);
+}
+
+Status BearingOnlyTracker::InitializeFromPoint(const BotObservation& observation,
+                                               const Eigen::Vector3d& point_in_world,
+                                               double depth_sigma) {
+  if (!point_in_world.allFinite() || !std::isfinite(depth_sigma)) {
+    ++stats_.rejected_inputs;
+    return Status::Error("BearingOnlyTracker: static point or depth sigma not finite");
+  }
+  return InitializeImpl(observation, &point_in_world, depth_sigma);
+}
+
+Status BearingOnlyTracker::InitializeImpl(const BotObservation& o,
+                                          const Eigen::Vector3d* point_in_world,
+                                          double depth_sigma) {
+  if (Status s = CheckObservation(o); !s.ok()) {
+    ++stats_.rejected_inputs;
+    return s.WithContext("BearingOnlyTracker::Initialize");
+  }
+  Reset();
+  if (FiniteGroundPlane(o.ground_plane)) plane_ = o.ground_plane;
+  const StepCues cues = MakeCues(&o);
+  const Rigid3d world_from_cam = o.cam_from_world.Inverse();
+  const Eigen::Vector3d ray = world_from_cam.rotation * o.xy.homogeneous();  // unit camera depth
+  const Eigen::Vector3d center = world_from_cam.translation;
+
+  // Depth prior: the depth bound (or the default range), or around the mapped depth.
+  double z_lo = options_.init_depth_min, z_hi = options_.init_depth_max;
+  if (options_.cues.depth_bound && o.depth_bound) {
+    z_lo = std::max(o.depth_bound->min, options_.min_depth);
+    if (std::isfinite(o.depth_bound->max)) z_hi = o.depth_bound->max;
+  }
+  z_lo = std::max(z_lo, options_.min_depth);
+  if (z_hi <= z_lo) z_hi = z_lo * 1.5;
+  double z_mean = 0.0, z_sigma = 0.0;
+  if (point_in_world != nullptr) {
+    z_mean = (o.cam_from_world * *point_in_world).z();
+    if (z_mean <= options_.min_depth) {
+      ++stats_.rejected_inputs;
+      return Status::Error("BearingOnlyTracker::InitializeFromPoint: point is behind the camera");
+    }
+    z_sigma = depth_sigma > 0.0 ? depth_sigma : options_.static_depth_sigma_ratio * z_mean;
+  }
+
+  const int n = options_.num_particles;
+  particles_.assign(static_cast<size_t>(n), BotParticle());
+  int violations = 0;
+  for (BotParticle& p : particles_) {
+    bool ok = false;
+    for (int attempt = 0; attempt < options_.max_rejection_tries && !ok; ++attempt) {
+      double z = point_in_world != nullptr ? rng_.Normal(z_mean, z_sigma) : rng_.Uniform(z_lo, z_hi);
+      z = std::max(z, options_.min_depth);
+      p.position = center + z * ray;
+      p.ground_height = cues.has_plane ? cues.plane.Height(p.position) : 0.0;
+      ok = InPsi(p, cues);
+    }
+    DrawInitialVelocity(&p, cues);
+    p.init_position = p.position;
+    p.log_weight = ok ? 0.0 : std::log(options_.violation_weight);
+    violations += ok ? 0 : 1;
+  }
+  initialized_ = true;
+  seated_ = false;
+  utime_ = o.utime;
+  init_utime_ = o.utime;
+  init_world_from_cam_ = world_from_cam;
+  cam_from_world_ = o.cam_from_world;
+  stats_.last_violation_share = static_cast<double>(violations) / n;
+  NormalizeAndResample();
+  ApplySfmMotion(o);
+  return Status::Ok();
+}
+
+void BearingOnlyTracker::RebaseGroundHeights(const std::optional<GroundPlane>& plane) {
+  if (!FiniteGroundPlane(plane)) return;
+  const bool changed = !plane_ || (plane_->normal - plane->normal).norm() > 1e-9 ||
+                       std::abs(plane_->offset - plane->offset) > 1e-9;
+  if (!changed) return;
+  // The same points, measured from the new plane (a refined static map).
+  for (BotParticle& p : particles_) {
+    const double old_h = plane_ ? plane_->Height(p.position) : 0.0;
+    const double offset = p.ground_height - old_h;  // how far the particle drifted from its height
+    p.ground_height = plane->Height(p.position) + (plane_ ? offset : 0.0);
+  }
+  plane_ = plane;
+}
+
+void BearingOnlyTracker::Propagate(double dt, const StepCues& c, std::vector<char>* violated) {
+  violated->assign(particles_.size(), 0);
+  const double sq = std::sqrt(std::max(dt, 0.0));
+  const double sv = options_.accel_sigma * sq;
+  const double sw = options_.angular_accel_sigma * sq;
+  const double sp = options_.position_sigma * sq;
+  const double sr = options_.rotation_sigma * sq;
+  const double sh = options_.ground_height_sigma * sq;
+  const Eigen::Vector3d n = c.plane.normal;
+  int violations = 0;
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    const BotParticle& prior = particles_[i];
+    BotParticle candidate = prior;
+    bool ok = false;
+    for (int attempt = 0; attempt < options_.max_rejection_tries && !ok; ++attempt) {
+      candidate = prior;
+      if (dt > 0.0) {
+        // Twist random walk (white-noise acceleration), then the constant-velocity step.
+        Eigen::Vector3d e = sv * Normal3(&rng_);
+        if (c.ground) e = InPlane(e, n);
+        candidate.linear_velocity += e;
+        Eigen::Vector3d jitter = sp * Normal3(&rng_);
+        if (c.ground) jitter = InPlane(jitter, n) + sh * rng_.Normal() * n;
+        if (orientation_tracked_) {
+          candidate.angular_velocity += sw * Normal3(&rng_);
+          const Eigen::Vector3d wdt = candidate.angular_velocity * dt;
+          candidate.position += LeftJacobianSO3(wdt) * candidate.linear_velocity * dt + jitter;
+          candidate.rotation =
+              Eigen::Quaterniond(ExpSO3(sr * Normal3(&rng_)) * ExpSO3(wdt) *
+                                 candidate.rotation.toRotationMatrix())
+                  .normalized();
+        } else {
+          candidate.position += candidate.linear_velocity * dt + jitter;
+        }
+      }
+      ok = InPsi(candidate, c);
+      if (dt <= 0.0) break;  // nothing to redraw
+    }
+    particles_[i] = candidate;
+    if (!ok) {
+      (*violated)[i] = 1;
+      ++violations;
+    }
+  }
+  stats_.last_violation_share =
+      particles_.empty() ? 0.0 : static_cast<double>(violations) / particles_.size();
+}
+
+void BearingOnlyTracker::HoldOnRay(const BotObservation& o) {
+  // Before the velocities are seated the particles keep their initial camera depth on the
+  // current ray (the object's depth is all they carry yet).
+  const Rigid3d world_from_cam = o.cam_from_world.Inverse();
+  const Eigen::Vector3d ray = world_from_cam.rotation * o.xy.homogeneous();
+  const Rigid3d init_cam_from_world = init_world_from_cam_.Inverse();
+  for (BotParticle& p : particles_) {
+    const double z = std::max((init_cam_from_world * p.init_position).z(), options_.min_depth);
+    p.position = world_from_cam.translation + z * ray;
+  }
+}
+
+void BearingOnlyTracker::SeatVelocities(const BotObservation& o, const StepCues& c) {
+  const double dt = static_cast<double>(o.utime - init_utime_) * kUsToS;
+  const Rigid3d world_from_cam = o.cam_from_world.Inverse();
+  const Eigen::Vector3d c2 = world_from_cam.translation;
+  const Eigen::Vector3d r2 = world_from_cam.rotation * o.xy.homogeneous();
+  const double s_min = options_.init_speed_min, s_max = options_.init_speed_max;
+  const double floor = options_.prior_speed_floor;
+  const double log_violation = std::log(options_.violation_weight);
+  double z_lo = options_.min_depth, z_hi = std::numeric_limits<double>::infinity();
+  if (c.depth) {
+    z_lo = std::max(z_lo, c.z_min);
+    z_hi = std::min(z_hi, c.z_max);
+  }
+  int violations = 0;
+  for (BotParticle& p : particles_) {
+    const Eigen::Vector3d p1 = p.init_position;
+    bool feasible = false;
+    double z = 0.0;
+    double log_w = 0.0;
+    if (c.ground) {
+      // Velocity in the plane: the particle keeps its height, so the new bearing meets its
+      // plane at one depth. Prior density ~1/|v| (uniform speed, uniform heading), area on
+      // the plane per image area z^3 / D (D: camera height above the particle's plane).
+      const double denom = c.plane.normal.dot(r2);
+      const double rise = p.ground_height - c.plane.Height(c2);
+      if (std::abs(denom) > 1e-9) {
+        z = rise / denom;
+        if (std::isfinite(z) && z >= z_lo && z <= z_hi) {
+          const Eigen::Vector3d v = InPlane((c2 + z * r2 - p1) / dt, c.plane.normal);
+          const double speed = v.norm();
+          if (speed >= s_min && speed <= s_max) {
+            feasible = true;
+            log_w = 3.0 * std::log(z) - std::log(std::max(std::abs(rise), 1e-6)) -
+                    std::log(std::max(speed, floor));
+          }
+        }
+      }
+      if (!feasible) z = std::clamp(std::isfinite(z) && z > 0.0 ? z : z_lo, z_lo, z_lo + 1e3);
+    } else {
+      // Free velocity: the new depth z is free; the speed prior (density ~1/|v|^2) limits it
+      // to the depths where |c2 + z r2 - p1| / dt lies in [s_min, s_max]. Weight: the
+      // integral of prior(v(z)) z^2 dz over them (z^2: volume per depth and image area).
+      const Eigen::Vector3d a = c2 - p1;
+      const double A = r2.squaredNorm(), B = a.dot(r2), C = a.squaredNorm();
+      std::vector<std::pair<double, double>> segments;
+      const double outer = B * B - A * (C - s_max * s_max * dt * dt);
+      if (outer > 0.0) {
+        const double lo = (-B - std::sqrt(outer)) / A, hi = (-B + std::sqrt(outer)) / A;
+        const double inner = s_min > 0.0 ? B * B - A * (C - s_min * s_min * dt * dt) : -1.0;
+        if (inner > 0.0) {
+          segments.push_back({lo, (-B - std::sqrt(inner)) / A});
+          segments.push_back({(-B + std::sqrt(inner)) / A, hi});
+        } else {
+          segments.push_back({lo, hi});
+        }
+      }
+      double length = 0.0;
+      for (auto& s : segments) {
+        s.first = std::max(s.first, z_lo);
+        s.second = std::min(s.second, z_hi);
+        if (s.second > s.first) length += s.second - s.first;
+      }
+      if (length > 0.0) {
+        // Piecewise-constant integrand on kSeatCells cells of the feasible depths.
+        double g[kSeatCells];
+        double z_at[kSeatCells];
+        double total = 0.0;
+        const double cell = length / kSeatCells;
+        for (int k = 0; k < kSeatCells; ++k) {
+          double u = (k + 0.5) * cell;
+          double zk = z_lo;
+          for (const auto& s : segments) {
+            if (s.second <= s.first) continue;
+            if (u <= s.second - s.first) {
+              zk = s.first + u;
+              break;
+            }
+            u -= s.second - s.first;
+          }
+          const double speed = std::max((a + zk * r2).norm() / dt, floor);
+          z_at[k] = zk;
+          g[k] = zk * zk / (speed * speed);
+          total += g[k];
+        }
+        if (total > 0.0) {
+          feasible = true;
+          log_w = std::log(total * cell);
+          double u = rng_.Uniform() * total;
+          int k = 0;
+          while (k < kSeatCells - 1 && u > g[k]) u -= g[k++];
+          z = z_at[k] + (rng_.Uniform() - 0.5) * cell;  // within the cell (approximately)
+          z = std::max(z, z_lo);
+        }
+      }
+      if (!feasible) z = std::clamp(std::max(-B / A, z_lo), z_lo, z_lo + 1e3);
+    }
+    p.position = c2 + z * r2;
+    Eigen::Vector3d v = (p.position - p1) / dt;
+    if (c.ground) {
+      v = InPlane(v, c.plane.normal);
+    } else if (c.has_plane) {
+      p.ground_height = c.plane.Height(p.position);
+    }
+    if (!feasible) {
+      // No velocity within the speed prior carries this particle onto the bearing.
+      const double speed = v.norm();
+      if (speed > s_max && speed > 0.0) v *= s_max / speed;
+    }
+    p.linear_velocity = v;
+    p.angular_velocity.setZero();
+    const bool in_psi = InPsi(p, c);
+    p.log_weight += (feasible ? log_w : 2.0 * log_violation) + (in_psi ? 0.0 : log_violation);
+    violations += (feasible && in_psi) ? 0 : 1;
+  }
+  stats_.last_violation_share =
+      particles_.empty() ? 0.0 : static_cast<double>(violations) / particles_.size();
+  seated_ = true;
+}
+
+bool BearingOnlyTracker::WeightByBearing(const BotObservation& o,
+                                         const std::vector<char>& violated) {
+  const double sigma_px = o.bearing_sigma_px > 0.0 ? o.bearing_sigma_px : options_.bearing_sigma_px;
+  const double eta = sigma_px / o.focal_px;
+  const double inv_two_eta2 = 1.0 / (2.0 * eta * eta);
+  const Eigen::Matrix3d R = o.cam_from_world.RotationMatrix();
+  const Eigen::Vector3d t = o.cam_from_world.translation;
+  const double log_violation = std::log(options_.violation_weight);
+  std::vector<double> r2(particles_.size());
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    const Eigen::Vector3d pc = R * particles_[i].position + t;
+    if (pc.z() < options_.min_depth) {
+      r2[i] = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    r2[i] = (o.xy - pc.head<2>() / pc.z()).squaredNorm();
+    best = std::min(best, r2[i]);
+  }
+  const double lost = options_.lost_residual_px / o.focal_px;
+  if (!(best <= lost * lost)) {
+    // The bearing is far from every particle (a jump of the reference point, a wrong
+    // association, or a diverged filter): keep each particle's depth, move it onto the ray.
+    const Rigid3d world_from_cam = o.cam_from_world.Inverse();
+    const Eigen::Vector3d ray = world_from_cam.rotation * o.xy.homogeneous();
+    for (BotParticle& p : particles_) {
+      const double z = std::max(std::abs((R * p.position + t).z()), options_.min_depth);
+      p.position = world_from_cam.translation + z * ray;
+      if (plane_) p.ground_height = plane_->Height(p.position);
+      p.log_weight = 0.0;
+    }
+    ++stats_.recoveries;
+    MBSLAM_LOG(DEBUG) << "object " << object_id_ << ": bearing " << std::sqrt(best) * o.focal_px
+                      << " px from every particle, particles moved onto the ray";
+    return false;
+  }
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    BotParticle& p = particles_[i];
+    p.log_weight += std::isfinite(r2[i]) ? -r2[i] * inv_two_eta2 : kUnmeasurableLogWeight;
+    if (violated[i]) p.log_weight += log_violation;
+  }
+  return true;
+}
+
+void BearingOnlyTracker::WeightBySfm(const BotObservation& o) {
+  if (!options_.cues.sfm_feedback || !o.sfm || sfm_history_.empty() || !seated_) return;
+  const SfmState& last = sfm_history_.back();
+  if (last.map_id != o.sfm->map_id) return;
+  const Eigen::Vector3d q = o.sfm->cam_from_obj * o.sfm->reference_in_obj;
+  if (!(q.z() > 0.0)) return;
+  const Rigid3d world_from_cam = o.cam_from_world.Inverse();
+  const double dt = std::max(static_cast<double>(o.utime - last.utime) * kUsToS, 0.0);
+  const double process = options_.position_sigma * options_.position_sigma * dt +
+                         options_.accel_sigma * options_.accel_sigma * dt * dt * dt / 3.0;
+  const double ratio2 = options_.sfm_sigma_ratio * options_.sfm_sigma_ratio;
+  for (BotParticle& p : particles_) {
+    if (!(p.sfm_scale > 0.0)) continue;
+    // Eq. 6.3: where the reconstruction puts this particle at its scale.
+    const Eigen::Vector3d q_s = p.sfm_scale * q;
+    const Eigen::Vector3d predicted = world_from_cam * q_s;
+    const double var = ratio2 * q_s.z() * q_s.z() + process;
+    p.log_weight -= (p.position - predicted).squaredNorm() / (2.0 * var);
+  }
+}
+
+void BearingOnlyTracker::ApplySfmMotion(const BotObservation& o) {
+  if (!options_.cues.sfm_feedback || !o.sfm) return;
+  const Eigen::Vector3d q = o.sfm->cam_from_obj * o.sfm->reference_in_obj;
+  if (!(q.z() > 0.0)) return;
+  if (!sfm_history_.empty() && sfm_history_.back().map_id != o.sfm->map_id) {
+    sfm_history_.clear();  // a new reconstruction: its scale is unrelated to the old one
+  }
+  SfmState now;
+  now.map_id = o.sfm->map_id;
+  now.utime = o.utime;
+  now.world_from_cam = o.cam_from_world.Inverse();
+  now.reference_in_cam = q;
+  now.world_from_obj_rotation =
+      (now.world_from_cam.rotation * o.sfm->cam_from_obj.rotation).normalized();
+
+  // The SfM-implied twist over at least the baseline: the newest older image that far back.
+  const SfmState* ref = nullptr;
+  for (auto it = sfm_history_.rbegin(); it != sfm_history_.rend(); ++it) {
+    if (it->utime < o.utime) ref = &*it;
+    if (o.utime - it->utime >= options_.sfm_velocity_baseline_us) break;
+  }
+  const Eigen::Matrix3d R_cw = o.cam_from_world.RotationMatrix();
+  const Eigen::Vector3d t_cw = o.cam_from_world.translation;
+  const double g = options_.sfm_velocity_gain;
+  Eigen::Vector3d w_sfm = Eigen::Vector3d::Zero();
+  double dt = 0.0;
+  if (ref != nullptr) {
+    dt = static_cast<double>(o.utime - ref->utime) * kUsToS;
+    w_sfm = LogSO3((now.world_from_obj_rotation * ref->world_from_obj_rotation.conjugate())
+                       .toRotationMatrix()) / dt;
+  }
+  const bool ground = options_.cues.ground_plane && FiniteGroundPlane(plane_);
+  for (BotParticle& p : particles_) {
+    const double z = R_cw.row(2).dot(p.position) + t_cw.z();
+    if (z <= options_.min_depth) continue;
+    const double s = z / q.z();
+    p.sfm_scale = s;
+    p.rotation = now.world_from_obj_rotation;
+    if (ref != nullptr && seated_) {
+      // Eq. 6.4: the survivor moves with the reconstruction's motion at its own scale.
+      Eigen::Vector3d v = (now.world_from_cam * (s * q) -
+                           ref->world_from_cam * (s * ref->reference_in_cam)) / dt;
+      if (ground) v = InPlane(v, plane_->normal);
+      p.linear_velocity = (1.0 - g) * p.linear_velocity + g * v;
+      p.angular_velocity = (1.0 - g) * p.angular_velocity + g * w_sfm;
+    }
+  }
+  orientation_tracked_ = true;
+  sfm_history_.push_back(now);
+  // Keep what the baseline needs (and a little more).
+  while (sfm_history_.size() > 2 &&
+         o.utime - sfm_history_[1].utime >= options_.sfm_velocity_baseline_us) {
+    sfm_history_.pop_front();
+  }
+}
+
+void BearingOnlyTracker::NormalizeAndResample() {
+  const size_t n = particles_.size();
+  if (n == 0) return;
+  double max_log = -std::numeric_limits<double>::infinity();
+  for (const BotParticle& p : particles_) max_log = std::max(max_log, p.log_weight);
+  std::vector<double> w(n);
+  double sum = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    w[i] = std::exp(particles_[i].log_weight - max_log);
+    sum += w[i];
+  }
+  double sum_sq = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    w[i] /= sum;
+    sum_sq += w[i] * w[i];
+    particles_[i].log_weight = w[i] > 0.0 ? std::log(w[i]) : -745.0;
+  }
+  const double ess = 1.0 / sum_sq;
+  stats_.last_ess = ess;
+  if (ess >= options_.resample_ess_ratio * static_cast<double>(n)) return;
+
+  // Systematic resampling: one uniform offset, n equally spaced positions on the CDF.
+  std::vector<BotParticle> next;
+  next.reserve(n);
+  const double step = 1.0 / static_cast<double>(n);
+  double u = rng_.Uniform() * step;
+  double cdf = w[0];
+  size_t j = 0;
+  for (size_t k = 0; k < n; ++k) {
+    while (u > cdf && j + 1 < n) cdf += w[++j];
+    next.push_back(particles_[j]);
+    u += step;
+  }
+  const double log_uniform = -std::log(static_cast<double>(n));
+  for (BotParticle& p : next) p.log_weight = log_uniform;
+  particles_.swap(next);
+  ++stats_.resamplings;
+}
+
+Status BearingOnlyTracker::Update(const BotObservation& o) {
+  if (!initialized_) return Status::Error("BearingOnlyTracker::Update before Initialize");
+  if (Status s = CheckObservation(o); !s.ok()) {
+    ++stats_.rejected_inputs;
+    return s.WithContext("BearingOnlyTracker::Update");
+  }
+  if (o.utime < utime_) {
+    ++stats_.rejected_inputs;
+    return Status::Error("BearingOnlyTracker::Update: time went backwards (" +
+                         std::to_string(o.utime) + " < " + std::to_string(utime_) + ")");
+  }
+  const double dt = static_cast<double>(o.utime - utime_) * kUsToS;
+  RebaseGroundHeights(o.ground_plane);
+  const StepCues cues = MakeCues(&o);
+  ++stats_.updates;
+  utime_ = o.utime;
+  cam_from_world_ = o.cam_from_world;
+
+  if (!seated_) {
+    if (o.utime - init_utime_ < std::max<int64_t>(options_.init_velocity_baseline_us, 1)) {
+      HoldOnRay(o);
+      return Status::Ok();
+    }
+    SeatVelocities(o, cues);
+    NormalizeAndResample();
+    ApplySfmMotion(o);
+    return Status::Ok();
+  }
+
+  std::vector<char> violated;
+  Propagate(dt, cues, &violated);
+  WeightBySfm(o);
+  WeightByBearing(o, violated);
+  NormalizeAndResample();
+  ApplySfmMotion(o);
+  return Status::Ok();
+}
+
+Status BearingOnlyTracker::Predict(int64_t utime, const std::optional<GroundPlane>& ground_plane) {
+  if (!initialized_) return Status::Error("BearingOnlyTracker::Predict before Initialize");
+  if (utime < utime_) {
+    ++stats_.rejected_inputs;
+    return Status::Error("BearingOnlyTracker::Predict: time went backwards");
+  }
+  ++stats_.predictions;
+  if (!seated_) {  // nothing known about the motion yet
+    utime_ = utime;
+    return Status::Ok();
+  }
+  RebaseGroundHeights(ground_plane);
+  const StepCues cues = MakeCues(nullptr);
+  std::vector<char> violated;
+  Propagate(static_cast<double>(utime - utime_) * kUsToS, cues, &violated);
+  const double log_violation = std::log(options_.violation_weight);
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    if (violated[i]) particles_[i].log_weight += log_violation;
+  }
+  utime_ = utime;
+  NormalizeAndResample();
+  return Status::Ok();
+}
+
+std::vector<int> BearingOnlyTracker::SystematicIndices(int count) const {
+  std::vector<int> indices;
+  const size_t n = particles_.size();
+  if (n == 0 || count <= 0) return indices;
+  indices.reserve(static_cast<size_t>(count));
+  const double step = 1.0 / count;
+  double u = 0.5 * step;
+  double cdf = std::exp(particles_[0].log_weight);
+  size_t j = 0;
+  for (int k = 0; k < count; ++k) {
+    while (u > cdf && j + 1 < n) cdf += std::exp(particles_[++j].log_weight);
+    indices.push_back(static_cast<int>(j));
+    u += step;
+  }
+  return indices;
+}
+
+BotEstimate BearingOnlyTracker::Estimate() const {
+  BotEstimate e;
+  e.utime = utime_;
+  e.valid = initialized_ && !particles_.empty();
+  if (!e.valid) return e;
+  e.velocity_initialized = seated_;
+  e.num_particles = static_cast<int>(particles_.size());
+  e.effective_sample_size = stats_.last_ess;
+
+  const Eigen::Matrix3d R = cam_from_world_.RotationMatrix();
+  const Eigen::Vector3d t = cam_from_world_.translation;
+  Eigen::Vector3d mean_p = Eigen::Vector3d::Zero();
+  Vector6d mean_v = Vector6d::Zero();
+  double mean_z = 0.0;
+  std::vector<double> w(particles_.size());
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    const BotParticle& p = particles_[i];
+    w[i] = std::exp(p.log_weight);
+    mean_p += w[i] * p.position;
+    mean_v += w[i] * p.twist();
+    mean_z += w[i] * (R.row(2).dot(p.position) + t.z());
+  }
+  // Mean orientation: the particles share their rotation up to jitter; average the
+  // quaternions on one hemisphere.
+  Eigen::Quaterniond mean_q = Eigen::Quaterniond::Identity();
+  if (orientation_tracked_) {
+    const Eigen::Quaterniond q0 = particles_[0].rotation;
+    Eigen::Vector4d acc = Eigen::Vector4d::Zero();
+    for (size_t i = 0; i < particles_.size(); ++i) {
+      Eigen::Vector4d c = particles_[i].rotation.coeffs();
+      if (c.dot(q0.coeffs()) < 0.0) c = -c;
+      acc += w[i] * c;
+    }
+    if (acc.norm() > 1e-12) mean_q = Eigen::Quaterniond(acc / acc.norm());
+  }
+  Matrix6d pose_cov = Matrix6d::Zero();
+  Matrix6d vel_cov = Matrix6d::Zero();
+  double var_z = 0.0;
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    const BotParticle& p = particles_[i];
+    Vector6d d;
+    d.head<3>() = p.position - mean_p;
+    d.tail<3>() = orientation_tracked_
+                      ? LogSO3((p.rotation * mean_q.conjugate()).toRotationMatrix())
+                      : Eigen::Vector3d::Zero();
+    pose_cov += w[i] * d * d.transpose();
+    const Vector6d dv = p.twist() - mean_v;
+    vel_cov += w[i] * dv * dv.transpose();
+    const double dz = R.row(2).dot(p.position) + t.z() - mean_z;
+    var_z += w[i] * dz * dz;
+  }
+  if (!orientation_tracked_) {
+    pose_cov.bottomRightCorner<3, 3>() = M_PI * M_PI * Eigen::Matrix3d::Identity();
+  }
+  e.world_from_object = Rigid3d(mean_q, mean_p);
+  e.has_orientation = orientation_tracked_;
+  e.pose_covariance = pose_cov;
+  e.linear_velocity = mean_v.head<3>();
+  e.angular_velocity = mean_v.tail<3>();
+  e.has_angular_velocity = orientation_tracked_;
+  e.velocity_covariance = vel_cov;
+  e.depth = mean_z;
+  e.depth_sigma = std::sqrt(std::max(var_z, 0.0));
+  e.reliable = seated_ && mean_z > 0.0 &&
+               e.depth_sigma <= options_.reliable_depth_sigma_ratio * mean_z;
+  for (int i : SystematicIndices(options_.num_output_samples)) {
+    e.particle_samples.push_back(particles_[static_cast<size_t>(i)].position.cast<float>());
+  }
+  e.relative_scale = RelativeScaleFromSfm();
+  return e;
+}
+
+std::optional<RelativeScaleEstimate> BearingOnlyTracker::RelativeScaleFromSfm() const {
+  if (!initialized_ || sfm_history_.empty()) return std::nullopt;
+  double sum_w = 0.0, mean = 0.0;
+  for (const BotParticle& p : particles_) {
+    if (!(p.sfm_scale > 0.0)) continue;
+    const double w = std::exp(p.log_weight);
+    sum_w += w;
+    mean += w * p.sfm_scale;
+  }
+  if (!(sum_w > 0.0)) return std::nullopt;
+  mean /= sum_w;
+  double var = 0.0;
+  for (const BotParticle& p : particles_) {
+    if (!(p.sfm_scale > 0.0)) continue;
+    const double d = p.sfm_scale - mean;
+    var += std::exp(p.log_weight) * d * d;
+  }
+  RelativeScaleEstimate e;
+  e.scale = mean;
+  e.sigma = std::sqrt(var / sum_w);
+  return e;
+}
+
+std::vector<PredictedVolume> BearingOnlyTracker::PredictVolumes(const ObjectExtent& extent) const {
+  std::vector<PredictedVolume> volumes;
+  if (!initialized_ || particles_.empty()) return volumes;
+  const PredictedVolumeOptions& vo = options_.volumes;
+  const std::vector<int> indices =
+      SystematicIndices(std::min<int>(vo.max_samples, static_cast<int>(particles_.size())));
+  std::optional<Eigen::Vector3d> up;
+  if (plane_) up = plane_->normal;
+  std::vector<Eigen::Vector3d> centers(indices.size());
+  const int64_t first = vo.include_current ? 0 : vo.step_us;
+  for (int64_t h = first; h <= vo.horizon_us; h += vo.step_us) {
+    const double tau = static_cast<double>(h) * kUsToS;
+    for (size_t k = 0; k < indices.size(); ++k) {
+      const BotParticle& p = particles_[static_cast<size_t>(indices[k])];
+      // Before the velocities are seated the motion is unknown: the prior speeds apply.
+      Eigen::Vector3d step = p.linear_velocity * tau;
+      if (orientation_tracked_) step = LeftJacobianSO3(p.angular_velocity * tau) * step;
+      centers[k] = p.position + step;
+    }
+    PredictedVolume v = BoundingVolume(centers, up, extent, vo.probability,
+                                       0.5 * vo.accel_margin * tau * tau);
+    v.utime = utime_ + h;
+    v.horizon_us = h;
+    volumes.push_back(v);
+    if (vo.step_us <= 0) break;
+  }
+  return volumes;
+}
+
+void BearingOnlyTracker::RescaleWorld(double factor) {
+  if (!(factor > 0.0) || !std::isfinite(factor)) return;
+  for (BotParticle& p : particles_) {
+    p.position *= factor;
+    p.init_position *= factor;
+    p.linear_velocity *= factor;
+    p.ground_height *= factor;
+    p.sfm_scale *= factor;
+  }
+  if (plane_) plane_->Rescale(factor);
+  init_world_from_cam_.translation *= factor;
+  cam_from_world_.translation *= factor;
+  for (SfmState& s : sfm_history_) s.world_from_cam.translation *= factor;
+}
+
+}  // namespace mbslam

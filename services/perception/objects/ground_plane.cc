@@ -1,0 +1,161 @@
+#include "services/perception/objects/ground_plane.h"
+
+#include <cmath>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+
+#include "services/perception/objects/random.h"
+
+namespace mbslam {
+
+bool GroundPlane::IsValid() const {
+  return normal.allFinite() && std::isfinite(offset) && std::abs(normal.norm() - 1.0) < 1e-6;
+}
+
+Eigen::Vector4d GroundPlane::ToVector4() const {
+  Eigen::Vector4d v;
+  v << normal, offset;
+  return v;
+}
+
+std::optional<GroundPlane> GroundPlane::FromVector4(const Eigen::Vector4d& plane) {
+  if (!plane.allFinite()) return std::nullopt;
+  const double n = plane.head<3>().norm();
+  if (n < 1e-12) return std::nullopt;
+  GroundPlane g;
+  g.normal = plane.head<3>() / n;
+  g.offset = plane[3] / n;
+  return g;
+}
+
+namespace {
+
+// Least-squares plane through `points[indices]`, normal oriented along `up`.
+bool FitPlane(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& indices,
+              const Eigen::Vector3d& up, GroundPlane* plane) {
+  if (indices.size() < 3) return false;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i : indices) mean += points[static_cast<size_t>(i)];
+  mean /= static_cast<double>(indices.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i : indices) {
+    const Eigen::Vector3d d = points[static_cast<size_t>(i)] - mean;
+    cov += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  if (eig.info() != Eigen::Success) return false;
+  Eigen::Vector3d n = eig.eigenvectors().col(0);  // smallest eigenvalue first
+  if (!n.allFinite() || n.norm() < 1e-12) return false;
+  n.normalize();
+  if (n.dot(up) < 0.0) n = -n;
+  plane->normal = n;
+  plane->offset = -n.dot(mean);
+  return true;
+}
+
+void CollectInliers(const std::vector<Eigen::Vector3d>& points, const GroundPlane& plane,
+                    double threshold, std::vector<int>* inliers) {
+  inliers->clear();
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (std::abs(plane.Height(points[i])) <= threshold) inliers->push_back(static_cast<int>(i));
+  }
+}
+
+}  // namespace
+
+Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
+                           const Eigen::Vector3d& up_hint, const GroundPlaneOptions& options,
+                           GroundPlaneEstimate* estimate) {
+  if (estimate == nullptr) return Status::Error("EstimateGroundPlane: null output");
+  if (!options.Check()) return Status::Error("ground plane options: " + LastOptionError());
+  if (!up_hint.allFinite() || up_hint.norm() < 1e-12) {
+    return Status::Error("EstimateGroundPlane: the up hint is zero or not finite");
+  }
+  const Eigen::Vector3d up = up_hint.normalized();
+  std::vector<Eigen::Vector3d> finite;
+  finite.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) {
+    if (p.allFinite()) finite.push_back(p);
+  }
+  const int n = static_cast<int>(finite.size());
+  if (n < 3) {
+    return Status::Error("EstimateGroundPlane: " + std::to_string(n) + " finite points, need 3");
+  }
+  const double cos_tilt = std::cos(options.max_tilt_deg * M_PI / 180.0);
+  ParticleRng rng(static_cast<uint64_t>(options.seed));
+
+  int best_count = 0;
+  double best_score = 0.0;
+  GroundPlane best;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    const int a = static_cast<int>(rng.Uniform() * n);
+    const int b = static_cast<int>(rng.Uniform() * n);
+    const int c = static_cast<int>(rng.Uniform() * n);
+    if (a == b || b == c || a == c) continue;
+    const Eigen::Vector3d& pa = finite[static_cast<size_t>(a)];
+    Eigen::Vector3d normal = (finite[static_cast<size_t>(b)] - pa)
+                                 .cross(finite[static_cast<size_t>(c)] - pa);
+    const double norm = normal.norm();
+    if (norm < 1e-12) continue;
+    normal /= norm;
+    if (normal.dot(up) < 0.0) normal = -normal;
+    if (normal.dot(up) < cos_tilt) continue;
+    GroundPlane hypothesis;
+    hypothesis.normal = normal;
+    hypothesis.offset = -normal.dot(pa);
+    // MSAC-like score: inliers count with a bonus for being close to the plane.
+    int count = 0;
+    double score = 0.0;
+    const double t2 = options.inlier_threshold * options.inlier_threshold;
+    for (const Eigen::Vector3d& p : finite) {
+      const double h = hypothesis.Height(p);
+      if (h * h <= t2) {
+        ++count;
+        score += 1.0 - h * h / t2;
+      }
+    }
+    if (score > best_score) {
+      best_score = score;
+      best_count = count;
+      best = hypothesis;
+    }
+  }
+  if (best_count < 3) return Status::Error("EstimateGroundPlane: no near-horizontal plane found");
+
+  std::vector<int> inliers;
+  CollectInliers(finite, best, options.inlier_threshold, &inliers);
+  for (int r = 0; r < options.refine_iterations; ++r) {
+    GroundPlane refined;
+    if (!FitPlane(finite, inliers, up, &refined)) break;
+    if (refined.normal.dot(up) < cos_tilt) break;
+    std::vector<int> next;
+    CollectInliers(finite, refined, options.inlier_threshold, &next);
+    if (next.size() < inliers.size()) break;  // the refit lost support: keep the previous
+    best = refined;
+    inliers.swap(next);
+  }
+  const int count = static_cast<int>(inliers.size());
+  const double ratio = static_cast<double>(count) / static_cast<double>(n);
+  if (count < options.min_inliers || ratio < options.min_inlier_ratio) {
+    return Status::Error("EstimateGroundPlane: best plane has " + std::to_string(count) +
+                         " inliers of " + std::to_string(n) + " points");
+  }
+  double sq = 0.0;
+  for (int i : inliers) {
+    const double h = best.Height(finite[static_cast<size_t>(i)]);
+    sq += h * h;
+  }
+  estimate->plane = best;
+  estimate->num_inliers = count;
+  estimate->inlier_ratio = ratio;
+  estimate->rms = std::sqrt(sq / static_cast<double>(count));
+  return Status::Ok();
+}
+
+Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
+                           const Eigen::Vector3d& up_hint, GroundPlaneEstimate* estimate) {
+  return EstimateGroundPlane(points, up_hint, GroundPlaneOptions(), estimate);
+}
+
+}  // namespace mbslam

@@ -1,0 +1,86 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_OBJECTS_GROUND_PLANE_H_
+#define MBSLAM_SERVICES_PERCEPTION_OBJECTS_GROUND_PLANE_H_
+
+// The ground plane of the static world (thesis sec. 5.1.1), estimated robustly from the
+// static map's points: RANSAC over near-horizontal planes (normal within a tilt of an "up"
+// hint, e.g. minus the camera's y axis in the world), then least-squares refinement on the
+// inliers. It is the reference for the ground-plane and size-bound cues of the
+// bearing-only tracker, and MapOutput::ground_plane.
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/config/options.h"
+#include "common/util/status.h"
+
+namespace mbslam {
+
+// The plane {p : normal . p + offset = 0}; `normal` is a unit vector pointing up, so
+// Height(p) is the signed height of p above the ground (world units).
+struct GroundPlane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double offset = 0.0;  // (units)
+
+  double Height(const Eigen::Vector3d& point_in_world) const {
+    return normal.dot(point_in_world) + offset;
+  }
+  bool IsValid() const;
+  // [normal; offset], the layout of MapOutput::ground_plane.
+  Eigen::Vector4d ToVector4() const;
+  // Normalises the normal; nullopt for a zero or non-finite vector.
+  static std::optional<GroundPlane> FromVector4(const Eigen::Vector4d& plane);
+  // Multiplies the world's units by `factor` (the plane itself scales with the world).
+  void Rescale(double factor) { offset *= factor; }
+};
+
+struct GroundPlaneOptions {
+  int max_iterations = 400;         // RANSAC hypotheses (count)
+  double inlier_threshold = 0.05;   // point-to-plane distance of an inlier (world units)
+  double max_tilt_deg = 25.0;       // angle between the normal and the up hint at most (deg)
+  int min_inliers = 20;             // fewer inliers: no plane (count)
+  double min_inlier_ratio = 0.05;   // ... or a smaller share of the points: no plane [0, 1]
+  int refine_iterations = 3;        // least-squares refits with re-selected inliers (count)
+  int64_t seed = 1;                 // RANSAC sampling seed (deterministic)
+
+  bool Check() const {
+    MBSLAM_CHECK_OPTION_GT(max_iterations, 0);
+    MBSLAM_CHECK_OPTION_GT(inlier_threshold, 0.0);
+    MBSLAM_CHECK_OPTION(max_tilt_deg > 0.0 && max_tilt_deg < 90.0);
+    MBSLAM_CHECK_OPTION_GE(min_inliers, 3);
+    MBSLAM_CHECK_OPTION(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(refine_iterations, 0);
+    return true;
+  }
+  template <typename V>
+  void VisitFields(V& v) {
+    v("max_iterations", &max_iterations, "RANSAC hypotheses (count)");
+    v("inlier_threshold", &inlier_threshold, "point-to-plane distance of an inlier (world units)");
+    v("max_tilt_deg", &max_tilt_deg, "angle between the normal and the up hint at most (deg)");
+    v("min_inliers", &min_inliers, "fewer inliers: no plane (count)");
+    v("min_inlier_ratio", &min_inlier_ratio, "smaller inlier share: no plane [0, 1]");
+    v("refine_iterations", &refine_iterations, "least-squares refits (count)");
+    v("seed", &seed, "RANSAC sampling seed");
+  }
+};
+
+struct GroundPlaneEstimate {
+  GroundPlane plane;
+  int num_inliers = 0;
+  double inlier_ratio = 0.0;  // num_inliers / points [0, 1]
+  double rms = 0.0;           // point-to-plane RMS of the inliers (units)
+};
+
+// `up_hint`: roughly the world's up direction (need not be unit). Fails on fewer than
+// three finite points, a zero up hint, invalid options, or when no plane within the tilt
+// limit has enough inliers.
+Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
+                           const Eigen::Vector3d& up_hint, const GroundPlaneOptions& options,
+                           GroundPlaneEstimate* estimate);
+Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
+                           const Eigen::Vector3d& up_hint, GroundPlaneEstimate* estimate);
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_OBJECTS_GROUND_PLANE_H_
