@@ -10,10 +10,13 @@ namespace eval {
 Status UmeyamaAlignment(const std::vector<Eigen::Vector3d>& src,
                         const std::vector<Eigen::Vector3d>& dst, bool with_scale,
                         Sim3d* dst_from_src) {
-  if (src.size() != dst.size()) return Status::Error("alignment: point sets differ in size");
-  if (src.size() < 3)
+  if (src.size() != dst.size()) {
+    return Status::Error("alignment: point sets differ in size");
+  }
+  if (src.size() < 3) {
     return Status::Error("alignment: needs at least 3 point pairs, got " +
                          std::to_string(src.size()));
+  }
   const double n = static_cast<double>(src.size());
   Eigen::Vector3d mu_src = Eigen::Vector3d::Zero(), mu_dst = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < src.size(); ++i) {
@@ -32,14 +35,18 @@ Status UmeyamaAlignment(const std::vector<Eigen::Vector3d>& src,
   }
   sigma /= n;
   var_src /= n;
-  if (!(var_src > 1e-24)) return Status::Error("alignment: the source points all coincide");
+  if (!(var_src > 1e-24)) {
+    return Status::Error("alignment: the source points all coincide");
+  }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sigma, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::Vector3d d = svd.singularValues();
+  const Eigen::Vector3d& d = svd.singularValues();
   if (d(1) <= 1e-12 * std::max(1.0, d(0))) {
     return Status::Error("alignment: the points are (nearly) collinear, rotation undetermined");
   }
   Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
-  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) S(2, 2) = -1.0;
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) {
+    S(2, 2) = -1.0;
+  }
   const Eigen::Matrix3d R = svd.matrixU() * S * svd.matrixV().transpose();
   const double scale = with_scale ? (d.asDiagonal() * S).trace() / var_src : 1.0;
   dst_from_src->scale = scale;

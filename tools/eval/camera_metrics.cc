@@ -21,21 +21,24 @@ const char* AlignmentName(Alignment a) {
 }
 
 bool ParseAlignment(const std::string& text, Alignment* a) {
-  if (text == "none")
+  if (text == "none") {
     *a = Alignment::kNone;
-  else if (text == "se3")
+  } else if (text == "se3") {
     *a = Alignment::kSE3;
-  else if (text == "sim3")
+  } else if (text == "sim3") {
     *a = Alignment::kSim3;
-  else
+  } else {
     return false;
+  }
   return true;
 }
 
 ErrorStats ErrorStats::From(std::vector<double> values) {
   ErrorStats s;
   s.count = static_cast<int>(values.size());
-  if (values.empty()) return s;
+  if (values.empty()) {
+    return s;
+  }
   double sum = 0.0, sum_sq = 0.0;
   for (double v : values) {
     sum += v;
@@ -45,7 +48,9 @@ ErrorStats ErrorStats::From(std::vector<double> values) {
   s.mean = sum / n;
   s.rmse = std::sqrt(sum_sq / n);
   double var = 0.0;
-  for (double v : values) var += (v - s.mean) * (v - s.mean);
+  for (double v : values) {
+    var += (v - s.mean) * (v - s.mean);
+  }
   s.std = std::sqrt(var / n);
   std::sort(values.begin(), values.end());
   s.min = values.front();
@@ -57,8 +62,10 @@ ErrorStats ErrorStats::From(std::vector<double> values) {
 
 Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions& options,
                   AteResult* result) {
-  if (!options.Check()) return Status::Error("ATE options: " + LastOptionError());
-  Alignment alignment;
+  if (!options.Check()) {
+    return Status::Error("ATE options: " + LastOptionError());
+  }
+  Alignment alignment = Alignment::kSim3;
   ParseAlignment(options.alignment, &alignment);
   *result = AteResult();
   result->num_est = static_cast<int>(est.size());
@@ -93,16 +100,22 @@ Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions&
 Status ComputeRpe(const Trajectory& est, const Trajectory& gt,
                   const std::vector<AssociatedPair>& pairs, const RpeOptions& options,
                   RpeResult* result) {
-  if (!options.Check()) return Status::Error("RPE options: " + LastOptionError());
+  if (!options.Check()) {
+    return Status::Error("RPE options: " + LastOptionError());
+  }
   std::vector<double> trans, rot;
   for (size_t i = 0; i < pairs.size(); ++i) {
     size_t j = i + static_cast<size_t>(options.delta_frames);
     if (options.delta_us > 0) {
       const int64_t target = gt[pairs[i].gt].utime + options.delta_us;
       j = i + 1;
-      while (j < pairs.size() && gt[pairs[j].gt].utime < target) ++j;
+      while (j < pairs.size() && gt[pairs[j].gt].utime < target) {
+        ++j;
+      }
     }
-    if (j >= pairs.size()) break;
+    if (j >= pairs.size()) {
+      break;
+    }
     const Rigid3d gt_rel = gt[pairs[i].gt].pose.Inverse() * gt[pairs[j].gt].pose;
     Rigid3d est_rel = est[pairs[i].est].pose.Inverse() * est[pairs[j].est].pose;
     est_rel.translation *= options.est_scale;
@@ -110,7 +123,9 @@ Status ComputeRpe(const Trajectory& est, const Trajectory& gt,
     trans.push_back(e.translation.norm());
     rot.push_back(e.rotation.angularDistance(Eigen::Quaterniond::Identity()) * 180.0 / M_PI);
   }
-  if (trans.empty()) return Status::Error("RPE: fewer associated poses than the delta");
+  if (trans.empty()) {
+    return Status::Error("RPE: fewer associated poses than the delta");
+  }
   result->translation = ErrorStats::From(trans);
   result->rotation_deg = ErrorStats::From(rot);
   return Status::Ok();
@@ -118,7 +133,9 @@ Status ComputeRpe(const Trajectory& est, const Trajectory& gt,
 
 double FractionTracked(const Trajectory& tracked_est, const Trajectory& gt,
                        int64_t max_time_diff_us) {
-  if (gt.empty()) return 0.0;
+  if (gt.empty()) {
+    return 0.0;
+  }
   return static_cast<double>(AssociateByTime(tracked_est, gt, max_time_diff_us).size()) /
          static_cast<double>(gt.size());
 }

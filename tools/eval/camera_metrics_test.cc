@@ -54,13 +54,16 @@ TEST(Umeyama, RecoversSimilarityExactly) {
   // Rigid alignment of a pure rotation + translation.
   Sim3d rigid = S;
   rigid.scale = 1.0;
-  for (size_t i = 0; i < src.size(); ++i) dst[i] = rigid * src[i];
+  for (size_t i = 0; i < src.size(); ++i) {
+    dst[i] = rigid * src[i];
+  }
   ASSERT_TRUE(UmeyamaAlignment(src, dst, false, &est).ok());
   EXPECT_DOUBLE_EQ(est.scale, 1.0);
   EXPECT_LT(est.rotation.angularDistance(rigid.rotation), 1e-12);
   // A reflection is never returned.
-  for (size_t i = 0; i < src.size(); ++i)
+  for (size_t i = 0; i < src.size(); ++i) {
     dst[i] = Eigen::Vector3d(src[i].x(), src[i].y(), -src[i].z());
+  }
   ASSERT_TRUE(UmeyamaAlignment(src, dst, true, &est).ok());
   EXPECT_NEAR(est.rotation.toRotationMatrix().determinant(), 1.0, 1e-12);
   // Degenerate inputs are refused.
@@ -142,7 +145,9 @@ TEST(Ate, AssociationWithDropsAndOffsets) {
   const Trajectory gt = MakeTruth(100);
   Trajectory est;
   for (size_t i = 0; i < gt.size(); ++i) {
-    if (i % 4 == 3) continue;  // a quarter not tracked
+    if (i % 4 == 3) {
+      continue;  // a quarter not tracked
+    }
     est.push_back({gt[i].utime + 5000, gt[i].pose});
   }
   AteOptions o;

@@ -51,9 +51,13 @@ std::string Stem(const std::string& path) { return fs::path(path).stem().string(
 }  // namespace
 
 std::string DataRoot() {
-  if (const char* env = std::getenv("MBSLAM_DATA"); env && *env) return env;
+  if (const char* env = std::getenv("MBSLAM_DATA"); env && *env) {
+    return env;
+  }
   std::string root = ".";
-  if (const char* src = std::getenv("MBSLAM_SOURCE_DIR"); src && *src) root = src;
+  if (const char* src = std::getenv("MBSLAM_SOURCE_DIR"); src && *src) {
+    root = src;
+  }
   return (fs::path(root) / ".." / "shared" / "data").lexically_normal().string();
 }
 
@@ -74,8 +78,9 @@ Status ParseTracks(const std::string& text, TrackSet* set) {
   }
   set->labels.assign(static_cast<size_t>(points), 0);
   for (int i = 0; i < points; ++i) {
-    if (!(in >> set->labels[static_cast<size_t>(i)]))
+    if (!(in >> set->labels[static_cast<size_t>(i)])) {
       return Status::Error("tracks: too few labels");
+    }
   }
   set->tracks.assign(static_cast<size_t>(points),
                      std::vector<Eigen::Vector2d>(static_cast<size_t>(frames)));
@@ -90,13 +95,19 @@ Status ParseTracks(const std::string& text, TrackSet* set) {
       auto& p = set->tracks[static_cast<size_t>(i)][static_cast<size_t>(f)];
       char* end = nullptr;
       p.x() = std::strtod(xs.c_str(), &end);
-      if (*end) return Status::Error("tracks: bad number '" + xs + "'");
+      if (*end) {
+        return Status::Error("tracks: bad number '" + xs + "'");
+      }
       p.y() = std::strtod(ys.c_str(), &end);
-      if (*end) return Status::Error("tracks: bad number '" + ys + "'");
+      if (*end) {
+        return Status::Error("tracks: bad number '" + ys + "'");
+      }
     }
   }
   std::string extra;
-  if (in >> extra) return Status::Error("tracks: unexpected data after the last track");
+  if (in >> extra) {
+    return Status::Error("tracks: unexpected data after the last track");
+  }
   return Status::Ok();
 }
 
@@ -116,8 +127,9 @@ Status ReadTracksFile(const std::string& path, TrackSet* set) {
 Status WriteTracksFile(const std::string& path, const TrackSet& set) {
   std::string text = std::to_string(set.num_points()) + " " + std::to_string(set.num_frames()) +
                      " " + std::to_string(set.width) + " " + std::to_string(set.height) + "\n";
-  for (size_t i = 0; i < set.labels.size(); ++i)
+  for (size_t i = 0; i < set.labels.size(); ++i) {
     text += (i ? " " : "") + std::to_string(set.labels[i]);
+  }
   text += "\n";
   char buf[64];
   for (const auto& track : set.tracks) {
@@ -136,13 +148,17 @@ Status WriteTracksFile(const std::string& path, const TrackSet& set) {
 
 Status ReadTracksFolder(const std::string& dir, std::vector<TrackSet>* sets) {
   sets->clear();
-  if (!IsDir(dir)) return Status::Error("not a directory: " + dir);
+  if (!IsDir(dir)) {
+    return Status::Error("not a directory: " + dir);
+  }
   for (const auto& path : ListFiles(dir, ".tracks.txt")) {
     TrackSet set;
     MBSLAM_RETURN_IF_ERROR(ReadTracksFile(path, &set));
     sets->push_back(std::move(set));
   }
-  if (sets->empty()) return Status::Error("no *.tracks.txt in " + dir);
+  if (sets->empty()) {
+    return Status::Error("no *.tracks.txt in " + dir);
+  }
   return Status::Ok();
 }
 
@@ -159,7 +175,9 @@ Status ReadLabelFile(const std::string& path, std::vector<int>* labels) {
     }
     char* end = nullptr;
     const long v = std::strtol(token.c_str(), &end, 10);
-    if (*end) return Status::Error(path + ": bad label '" + token + "'");
+    if (*end) {
+      return Status::Error(path + ": bad label '" + token + "'");
+    }
     labels->push_back(static_cast<int>(v));
   }
   return Status::Ok();
@@ -167,7 +185,9 @@ Status ReadLabelFile(const std::string& path, std::vector<int>* labels) {
 
 Status WriteLabelFile(const std::string& path, const std::vector<int>& labels) {
   std::string text;
-  for (size_t i = 0; i < labels.size(); ++i) text += (i ? " " : "") + std::to_string(labels[i]);
+  for (size_t i = 0; i < labels.size(); ++i) {
+    text += (i ? " " : "") + std::to_string(labels[i]);
+  }
   return WriteStringAtomically(path, text + "\n");
 }
 
@@ -175,11 +195,15 @@ Status ReadDavis(const std::string& root, std::vector<DavisSequence>* sequences)
   sequences->clear();
   const std::string ann = (fs::path(root) / "Annotations").string();
   const std::string img = (fs::path(root) / "JPEGImages").string();
-  if (!IsDir(ann)) return Status::Error("DAVIS: no Annotations/ in " + root);
+  if (!IsDir(ann)) {
+    return Status::Error("DAVIS: no Annotations/ in " + root);
+  }
   std::vector<std::string> names;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(ann, ec)) {
-    if (entry.is_directory()) names.push_back(entry.path().filename().string());
+    if (entry.is_directory()) {
+      names.push_back(entry.path().filename().string());
+    }
   }
   std::sort(names.begin(), names.end());
   for (const auto& name : names) {
@@ -187,19 +211,27 @@ Status ReadDavis(const std::string& root, std::vector<DavisSequence>* sequences)
     seq.name = name;
     for (const auto& mask : ListFiles((fs::path(ann) / name).string(), ".png")) {
       const std::string image = (fs::path(img) / name / (Stem(mask) + ".jpg")).string();
-      if (!IsFile(image)) return Status::Error("DAVIS: no image for mask " + mask);
+      if (!IsFile(image)) {
+        return Status::Error("DAVIS: no image for mask " + mask);
+      }
       seq.masks.push_back(mask);
       seq.images.push_back(image);
     }
-    if (!seq.masks.empty()) sequences->push_back(std::move(seq));
+    if (!seq.masks.empty()) {
+      sequences->push_back(std::move(seq));
+    }
   }
-  if (sequences->empty()) return Status::Error("DAVIS: no sequences in " + root);
+  if (sequences->empty()) {
+    return Status::Error("DAVIS: no sequences in " + root);
+  }
   return Status::Ok();
 }
 
 Status LoadBinaryMask(const std::string& path, cv::Mat* mask) {
   const cv::Mat raw = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (raw.empty()) return Status::Error("cannot read mask " + path);
+  if (raw.empty()) {
+    return Status::Error("cannot read mask " + path);
+  }
   *mask = raw != 0;
   return Status::Ok();
 }
@@ -208,14 +240,19 @@ Status ReadCamVid(const std::string& root, std::vector<CamVidFrame>* frames) {
   frames->clear();
   const std::string images = (fs::path(root) / "images").string();
   const std::string labels = (fs::path(root) / "labels").string();
-  if (!IsDir(images) || !IsDir(labels))
+  if (!IsDir(images) || !IsDir(labels)) {
     return Status::Error("CamVid: want images/ and labels/ in " + root);
+  }
   for (const auto& label : ListFiles(labels, ".png")) {
     const std::string image = (fs::path(images) / fs::path(label).filename()).string();
-    if (!IsFile(image)) return Status::Error("CamVid: no image for " + label);
+    if (!IsFile(image)) {
+      return Status::Error("CamVid: no image for " + label);
+    }
     frames->push_back({image, label});
   }
-  if (frames->empty()) return Status::Error("CamVid: no labelled frames in " + root);
+  if (frames->empty()) {
+    return Status::Error("CamVid: no labelled frames in " + root);
+  }
   return Status::Ok();
 }
 
@@ -235,17 +272,22 @@ CamVidFeatureStats CamVidMovingFeatureStats(const std::vector<LabelledFeature>& 
                                             const cv::Mat& labels) {
   CamVidFeatureStats s;
   for (const auto& f : features) {
-    if (!f.moving) continue;
+    if (!f.moving) {
+      continue;
+    }
     const int x = static_cast<int>(std::lround(f.u)), y = static_cast<int>(std::lround(f.v));
-    if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows) continue;
+    if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows) {
+      continue;
+    }
     const int label = labels.at<uint8_t>(y, x);
     ++s.moving;
-    if (IsCamVidStaticClass(label))
+    if (IsCamVidStaticClass(label)) {
       ++s.on_static;
-    else if (IsCamVidMovableClass(label))
+    } else if (IsCamVidMovableClass(label)) {
       ++s.on_movable;
-    else
+    } else {
       ++s.on_void;
+    }
   }
   s.Add(CamVidFeatureStats());  // computes the fractions
   return s;
@@ -314,7 +356,9 @@ Status ReadSequenceFolder(const std::string& dir, SequenceFolder* seq) {
     std::snprintf(name, sizeof(name), "%06zu", k);
     seq->images.push_back((root / "images" / (std::string(name) + ".png")).string());
     const std::string mask = (root / "masks" / (std::string(name) + ".png")).string();
-    if (IsFile(mask)) seq->masks.push_back(mask);
+    if (IsFile(mask)) {
+      seq->masks.push_back(mask);
+    }
     for (const char* ext : {".exr", ".png"}) {
       const std::string depth = (root / "depth" / (std::string(name) + ext)).string();
       if (IsFile(depth)) {
@@ -339,7 +383,9 @@ Status ReadSequenceFolder(const std::string& dir, SequenceFolder* seq) {
       try {
         body.id = o["id"].as<int>();
         body.name = o["name"].as<std::string>();
-        for (int i = 0; i < 3; ++i) body.extent[i] = o["extent"][i].as<double>();
+        for (int i = 0; i < 3; ++i) {
+          body.extent[i] = o["extent"][i].as<double>();
+        }
       } catch (const YAML::Exception& e) {
         return Status::Error(objects_yaml + ": " + e.what());
       }
@@ -354,7 +400,9 @@ Status ReadSequenceFolder(const std::string& dir, SequenceFolder* seq) {
       const std::string stem = Stem(path);
       char* end = nullptr;
       const long id = std::strtol(stem.c_str(), &end, 10);
-      if (*end) continue;  // not a body id
+      if (*end) {
+        continue;  // not a body id
+      }
       MBSLAM_RETURN_IF_ERROR(ReadPointsFile(path, &seq->points[static_cast<int>(id)]));
     }
   }

@@ -87,7 +87,9 @@ TEST(SharedData, Hopkins155) {
     EXPECT_EQ(static_cast<int>(s.labels.size()), s.num_points()) << s.name;
     EXPECT_GE(s.num_frames(), 2) << s.name;
     EXPECT_GT(s.width, 0);
-    if (s.name == "dancing") continue;
+    if (s.name == "dancing") {
+      continue;
+    }
     two += s.NumGroups() == 2;
     three += s.NumGroups() == 3;
   }

@@ -29,27 +29,39 @@ std::string Bin() {
 int RunEval(const std::string& args, Json* json) {
   const std::string cmd = Bin() + " " + args + " 2>/dev/null";
   FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return -1;
+  if (!pipe) {
+    return -1;
+  }
   std::string out;
   char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof(buf), pipe)) out.append(buf, n);
+  while (size_t n = fread(buf, 1, sizeof(buf), pipe)) {
+    out.append(buf, n);
+  }
   const int status = pclose(pipe);
-  while (!out.empty() && out.back() == '\n') out.pop_back();
+  while (!out.empty() && out.back() == '\n') {
+    out.pop_back();
+  }
   const size_t nl = out.rfind('\n');
   const std::string last = nl == std::string::npos ? out : out.substr(nl + 1);
-  if (json && !Json::Parse(last, json)) *json = Json();
+  if (json && !Json::Parse(last, json)) {
+    *json = Json();
+  }
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 class EvalCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!fs::exists(Bin())) GTEST_SKIP() << Bin() << " not built";
+    if (!fs::exists(Bin())) {
+      GTEST_SKIP() << Bin() << " not built";
+    }
     dir_ = fs::temp_directory_path() / ("mbslam_eval_cli_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
   }
   void TearDown() override {
-    if (!dir_.empty()) fs::remove_all(dir_);
+    if (!dir_.empty()) {
+      fs::remove_all(dir_);
+    }
   }
   std::string Path(const std::string& name) const { return (dir_ / name).string(); }
   fs::path dir_;
@@ -103,7 +115,9 @@ TEST_F(EvalCli, PerturbLabelsThenSegRecoversTheKnownAnswer) {
   {
     FILE* f = std::fopen(Path("truth.txt").c_str(), "w");
     ASSERT_NE(f, nullptr);
-    for (int i = 0; i < 300; ++i) std::fprintf(f, "%d ", i < 150 ? 1 : (i < 250 ? 2 : 3));
+    for (int i = 0; i < 300; ++i) {
+      std::fprintf(f, "%d ", i < 150 ? 1 : (i < 250 ? 2 : 3));
+    }
     std::fclose(f);
   }
   Json p;

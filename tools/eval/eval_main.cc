@@ -81,9 +81,13 @@ class Args {
   }
   // An error message for malformed or unknown arguments, empty if all is well.
   std::string Problems() const {
-    if (!bad_.empty()) return bad_;
+    if (!bad_.empty()) {
+      return bad_;
+    }
     for (const auto& kv : values_) {
-      if (!used_.count(kv.first)) return "unknown option --" + kv.first;
+      if (!used_.count(kv.first)) {
+        return "unknown option --" + kv.first;
+      }
     }
     return "";
   }
@@ -102,11 +106,15 @@ int Fail(const std::string& message) {
 int Finish(const Json& json, const Args& args) {
   const bool write_json = args.Has("json");
   const std::string problems = args.Problems();
-  if (!problems.empty()) return Fail(problems);
+  if (!problems.empty()) {
+    return Fail(problems);
+  }
   const std::string text = json.Dump();
   if (write_json) {
     const Status st = mbslam::WriteStringAtomically(args.Get("json"), text + "\n");
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
   }
   std::cout << text << std::endl;
   return 0;
@@ -165,7 +173,9 @@ int RunAte(const Args& args) {
   std::string gt_description, est_description;
   int est_messages = -1, est_metric = 0;
   Status st = LoadGroundTruthCamera(args, channels, &gt, &gt_description);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   if (args.Has("est")) {
     est_description = args.Get("est");
     st = eval::ReadTumTrajectory(args.Get("est"), &est);
@@ -180,14 +190,18 @@ int RunAte(const Args& args) {
   } else {
     st = Status::Error("ate: give --est FILE.tum or --est-log LOG");
   }
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
 
   eval::AteOptions options;
   options.alignment = args.Get("align", "sim3");
   options.max_time_diff_us = args.GetInt("max-dt-us", options.max_time_diff_us);
   eval::AteResult ate;
   st = eval::ComputeAte(est, gt, options, &ate);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   eval::RpeOptions rpe_options;
   rpe_options.delta_frames = static_cast<int>(args.GetInt("rpe-delta", 1));
   rpe_options.delta_us = args.GetInt("rpe-delta-us", 0);
@@ -224,7 +238,9 @@ int RunAte(const Args& args) {
                   ate.translation.rmse, options.alignment.c_str());
     plot.title = title;
     st = eval::WriteTopView(args.Get("plot"), gt, ate.est_aligned, plot);
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
     std::printf("  plot: %s\n", args.Get("plot").c_str());
   }
   Json j = Json::Object();
@@ -237,10 +253,14 @@ int RunAte(const Args& args) {
     j.Set("rpe_pairs", rpe.translation.count);
   }
   j.Set("ate_stats_m", StatsJson(ate.translation));
-  if (rpe_status.ok()) j.Set("rpe_trans_stats_m", StatsJson(rpe.translation));
+  if (rpe_status.ok()) {
+    j.Set("rpe_trans_stats_m", StatsJson(rpe.translation));
+  }
   j.Set("num_est", ate.num_est).Set("num_gt", ate.num_gt).Set("num_pairs", ate.pairs.size());
   j.Set("fraction_tracked", tracked);
-  if (est_messages >= 0) j.Set("est_messages", est_messages).Set("est_metric_messages", est_metric);
+  if (est_messages >= 0) {
+    j.Set("est_messages", est_messages).Set("est_metric_messages", est_metric);
+  }
   return Finish(j, args);
 }
 
@@ -259,7 +279,9 @@ Status LoadTruthLabels(const std::string& path, std::vector<int>* labels) {
 }
 
 double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
+  if (v.empty()) {
+    return 0.0;
+  }
   std::sort(v.begin(), v.end());
   const size_t m = v.size() / 2;
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
@@ -269,8 +291,12 @@ int RunSeg(const Args& args) {
   if (args.Has("pred") && args.Has("truth")) {
     std::vector<int> pred, truth;
     Status st = eval::ReadLabelFile(args.Get("pred"), &pred);
-    if (st.ok()) st = LoadTruthLabels(args.Get("truth"), &truth);
-    if (!st.ok()) return Fail(st.message());
+    if (st.ok()) {
+      st = LoadTruthLabels(args.Get("truth"), &truth);
+    }
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
     if (pred.size() != truth.size()) {
       return Fail("seg: " + std::to_string(pred.size()) + " predicted labels for " +
                   std::to_string(truth.size()) + " points");
@@ -288,12 +314,15 @@ int RunSeg(const Args& args) {
   }
   if (args.Has("pred-dir")) {
     const std::string tracks_dir = args.Get("tracks-dir", eval::DataSetPath("hopkins155"));
-    if (tracks_dir.empty())
+    if (tracks_dir.empty()) {
       return Fail("seg: no --tracks-dir and no hopkins155 under " + eval::DataRoot());
+    }
     const std::string suffix = args.Get("pred-suffix", ".labels.txt");
     std::vector<eval::TrackSet> sets;
     Status st = eval::ReadTracksFolder(tracks_dir, &sets);
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
     std::map<int, std::vector<double>> by_groups;
     std::vector<double> all;
     int missing = 0;
@@ -301,7 +330,9 @@ int RunSeg(const Args& args) {
     const bool include_dancing = args.Has("include-dancing");
     for (const auto& set : sets) {
       // Hopkins 155 is scored without its extra 'dancing' sequence (data README).
-      if (set.name == "dancing" && !include_dancing) continue;
+      if (set.name == "dancing" && !include_dancing) {
+        continue;
+      }
       const std::string pred_path = (fs::path(args.Get("pred-dir")) / (set.name + suffix)).string();
       std::vector<int> pred;
       if (!eval::ReadLabelFile(pred_path, &pred).ok() || pred.size() != set.labels.size()) {
@@ -313,12 +344,16 @@ int RunSeg(const Args& args) {
       all.push_back(r.rate);
       per.Set(set.name, r.rate);
     }
-    if (all.empty()) return Fail("seg: no usable predictions in " + args.Get("pred-dir"));
+    if (all.empty()) {
+      return Fail("seg: no usable predictions in " + args.Get("pred-dir"));
+    }
     Json j = Json::Object();
     j.Set("metric", "misclassification").Set("sequences", all.size()).Set("missing", missing);
     auto mean = [](const std::vector<double>& v) {
       double s = 0.0;
-      for (double x : v) s += x;
+      for (double x : v) {
+        s += x;
+      }
       return v.empty() ? 0.0 : s / static_cast<double>(v.size());
     };
     for (const auto& g : by_groups) {
@@ -345,13 +380,16 @@ Status ReadFeatureFile(const std::string& path,
   std::istringstream in(text);
   std::string line;
   while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
+    if (line.empty() || line[0] == '#') {
+      continue;
+    }
     std::istringstream ls(line);
     std::string stem;
     eval::LabelledFeature f;
     int moving = 0;
-    if (!(ls >> stem >> f.u >> f.v >> moving))
+    if (!(ls >> stem >> f.u >> f.v >> moving)) {
       return Status::Error(path + ": bad feature line '" + line + "'");
+    }
     f.moving = moving != 0;
     (*features)[stem].push_back(f);
   }
@@ -360,19 +398,27 @@ Status ReadFeatureFile(const std::string& path,
 
 int RunMasks(const Args& args) {
   const std::string pred_dir = args.Get("pred-dir"), gt_dir = args.Get("gt-dir");
-  if (pred_dir.empty() || gt_dir.empty()) return Fail("masks: give --pred-dir DIR --gt-dir DIR");
+  if (pred_dir.empty() || gt_dir.empty()) {
+    return Fail("masks: give --pred-dir DIR --gt-dir DIR");
+  }
   std::map<std::string, std::vector<eval::LabelledFeature>> features;
   if (args.Has("features")) {
     const Status st = ReadFeatureFile(args.Get("features"), &features);
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
   }
   std::vector<std::string> gt_files;
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(gt_dir, ec)) {
-    if (e.path().extension() == ".png") gt_files.push_back(e.path().string());
+    if (e.path().extension() == ".png") {
+      gt_files.push_back(e.path().string());
+    }
   }
   std::sort(gt_files.begin(), gt_files.end());
-  if (gt_files.empty()) return Fail("masks: no *.png in " + gt_dir);
+  if (gt_files.empty()) {
+    return Fail("masks: no *.png in " + gt_dir);
+  }
   std::vector<double> ious;
   eval::PrecisionRecall total;
   int missing = 0;
@@ -380,20 +426,30 @@ int RunMasks(const Args& args) {
     const std::string stem = fs::path(g).stem().string();
     cv::Mat truth, pred;
     Status st = eval::LoadBinaryMask(g, &truth);
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
     const std::string pred_path = (fs::path(pred_dir) / (stem + ".png")).string();
     if (!eval::LoadBinaryMask(pred_path, &pred).ok()) {
       ++missing;
       continue;
     }
-    if (pred.size() != truth.size()) return Fail("masks: size differs for " + stem);
+    if (pred.size() != truth.size()) {
+      return Fail("masks: size differs for " + stem);
+    }
     ious.push_back(eval::RegionIoU(pred, truth));
     auto it = features.find(stem);
-    if (it != features.end()) total.Add(eval::MovingFeaturePrecisionRecall(it->second, truth));
+    if (it != features.end()) {
+      total.Add(eval::MovingFeaturePrecisionRecall(it->second, truth));
+    }
   }
-  if (ious.empty()) return Fail("masks: no predicted mask matches a ground-truth file name");
+  if (ious.empty()) {
+    return Fail("masks: no predicted mask matches a ground-truth file name");
+  }
   double sum = 0.0;
-  for (double v : ious) sum += v;
+  for (double v : ious) {
+    sum += v;
+  }
   const double mean = sum / static_cast<double>(ious.size());
   std::printf("region IoU over %zu frames: mean %.4f, median %.4f (%d frames without prediction)\n",
               ious.size(), mean, Median(ious), missing);
@@ -413,23 +469,33 @@ int RunMasks(const Args& args) {
 
 int RunCamVid(const Args& args) {
   const std::string root = args.Get("root", eval::DataSetPath("camvid_0016E5_15hz"));
-  if (root.empty())
+  if (root.empty()) {
     return Fail("camvid: no --root and no camvid_0016E5_15hz under " + eval::DataRoot());
-  if (!args.Has("features"))
+  }
+  if (!args.Has("features")) {
     return Fail("camvid: give --features FILE (\"stem u v moving\" per line)");
+  }
   std::map<std::string, std::vector<eval::LabelledFeature>> features;
   Status st = ReadFeatureFile(args.Get("features"), &features);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   std::vector<eval::CamVidFrame> frames;
   st = eval::ReadCamVid(root, &frames);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   eval::CamVidFeatureStats total;
   int used = 0;
   for (const auto& f : frames) {
     auto it = features.find(fs::path(f.label).stem().string());
-    if (it == features.end()) continue;
+    if (it == features.end()) {
+      continue;
+    }
     const cv::Mat labels = cv::imread(f.label, cv::IMREAD_GRAYSCALE);
-    if (labels.empty()) return Fail("cannot read " + f.label);
+    if (labels.empty()) {
+      return Fail("cannot read " + f.label);
+    }
     total.Add(eval::CamVidMovingFeatureStats(it->second, labels));
     ++used;
   }
@@ -449,34 +515,45 @@ int RunCamVid(const Args& args) {
 
 int RunObjects(const Args& args) {
   const mbslam::ChannelOptions channels;
-  if (!args.Has("est-log") || !args.Has("gt-log"))
+  if (!args.Has("est-log") || !args.Has("gt-log")) {
     return Fail("objects: give --est-log LOG --gt-log LOG");
+  }
   eval::GroundTruthLog gt;
   Status st = eval::ReadGroundTruthLog(args.Get("gt-log"),
                                        args.Get("gt-channel", channels.ground_truth), &gt);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   std::map<int, eval::ObjectEstimate> objects;
   int messages = 0;
   st = eval::ReadObjectsLog(args.Get("est-log"),
                             args.Get("objects-channel", channels.perception_objects), &objects,
                             &messages);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   // The estimate's world frame, from the camera trajectories.
   eval::CameraPoseLog cam;
   st = eval::ReadCameraPoseLog(args.Get("est-log"),
                                args.Get("est-channel", channels.perception_camera_pose), &cam);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   eval::AteOptions ate_options;
   ate_options.alignment = args.Get("align", "sim3");
   eval::AteResult ate;
   st = eval::ComputeAte(cam.tracked, gt.camera, ate_options, &ate);
-  if (!st.ok()) return Fail("objects: cannot align the estimate's world frame: " + st.message());
+  if (!st.ok()) {
+    return Fail("objects: cannot align the estimate's world frame: " + st.message());
+  }
   eval::ObjectMetricsOptions options;
   options.horizon_us = args.GetInt("horizon-us", options.horizon_us);
   options.max_match_distance = args.GetDouble("max-match-m", options.max_match_distance);
   eval::ObjectsEvaluation result;
   st = eval::EvaluateObjects(objects, gt.bodies, gt.camera, ate.gt_from_est, options, &result);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   std::printf(
       "objects: %d estimated, %d true bodies, %zu matched, %d unmatched estimates (camera ATE %.4f "
       "m)\n",
@@ -501,7 +578,9 @@ int RunObjects(const Args& args) {
     oj.Set("best_scale", o.best_scale).Set("relative_scale_error", o.relative_scale_error);
     oj.Set("depth_rmse_m", o.depth_error.rmse).Set("volume_hit_rate", o.hit_rate);
     Json series = Json::Array();
-    for (const auto& d : o.depth_error_over_time) series.Push(d.second);
+    for (const auto& d : o.depth_error_over_time) {
+      series.Push(d.second);
+    }
     oj.Set("depth_error_over_time_m", series);
     list.Push(oj);
   }
@@ -521,12 +600,17 @@ int RunObjects(const Args& args) {
 // ---------------------------------------------------------------- points
 
 int RunPoints(const Args& args) {
-  if (!args.Has("est") || !args.Has("gt"))
+  if (!args.Has("est") || !args.Has("gt")) {
     return Fail("points: give --est XYZ --gt XYZ (same frame and units)");
+  }
   std::vector<Eigen::Vector3d> est, gt;
   Status st = eval::ReadPointsFile(args.Get("est"), &est);
-  if (st.ok()) st = eval::ReadPointsFile(args.Get("gt"), &gt);
-  if (!st.ok()) return Fail(st.message());
+  if (st.ok()) {
+    st = eval::ReadPointsFile(args.Get("gt"), &gt);
+  }
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   const double threshold = args.GetDouble("threshold", 0.05);
   const double max_distance = args.GetDouble("max-distance", 1.0);
   const eval::ReconstructionError e = eval::CompareToSurface(est, gt, threshold, max_distance);
@@ -546,18 +630,26 @@ int RunPoints(const Args& args) {
 // ---------------------------------------------------------------- perturb
 
 int RunPerturb(const Args& args) {
-  if (!args.Has("in") || !args.Has("out")) return Fail("perturb: give --in GT.tum --out EST.tum");
+  if (!args.Has("in") || !args.Has("out")) {
+    return Fail("perturb: give --in GT.tum --out EST.tum");
+  }
   eval::Trajectory gt, est;
   Status st = eval::ReadTumTrajectory(args.Get("in"), &gt);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   eval::TrajectoryPerturbation p;
   p.gt_from_est.scale = args.GetDouble("scale", 1.0);
   Eigen::Vector3d axis(0.0, 0.0, 1.0), trans = Eigen::Vector3d::Zero();
-  if (args.Has("axis") && !ParseVector3(args.Get("axis"), &axis))
+  if (args.Has("axis") && !ParseVector3(args.Get("axis"), &axis)) {
     return Fail("perturb: --axis wants x,y,z");
-  if (args.Has("trans") && !ParseVector3(args.Get("trans"), &trans))
+  }
+  if (args.Has("trans") && !ParseVector3(args.Get("trans"), &trans)) {
     return Fail("perturb: --trans wants x,y,z");
-  if (axis.norm() == 0.0 || !(p.gt_from_est.scale > 0.0)) return Fail("perturb: bad axis or scale");
+  }
+  if (axis.norm() == 0.0 || !(p.gt_from_est.scale > 0.0)) {
+    return Fail("perturb: bad axis or scale");
+  }
   p.gt_from_est.rotation = Eigen::Quaterniond(
       Eigen::AngleAxisd(args.GetDouble("rot-deg", 0.0) * M_PI / 180.0, axis.normalized()));
   p.gt_from_est.translation = trans;
@@ -566,9 +658,12 @@ int RunPerturb(const Args& args) {
   p.exact = !args.Has("no-exact");
   double expected = 0.0;
   st = eval::PerturbTrajectory(gt, p, &est, &expected);
-  if (st.ok())
+  if (st.ok()) {
     st = eval::WriteTumTrajectory(args.Get("out"), est, "perturbed copy of " + args.Get("in"));
-  if (!st.ok()) return Fail(st.message());
+  }
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   std::printf("wrote %zu poses to %s: est = S^-1 (gt + n), scale %.6f, noise rms %.6f m%s\n",
               est.size(), args.Get("out").c_str(), p.gt_from_est.scale, expected,
               p.exact ? " (exact)" : "");
@@ -579,11 +674,14 @@ int RunPerturb(const Args& args) {
 }
 
 int RunPerturbLabels(const Args& args) {
-  if (!args.Has("truth") || !args.Has("out"))
+  if (!args.Has("truth") || !args.Has("out")) {
     return Fail("perturb-labels: give --truth FILE --out FILE");
+  }
   std::vector<int> truth, pred;
   Status st = LoadTruthLabels(args.Get("truth"), &truth);
-  if (!st.ok()) return Fail(st.message());
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   eval::LabelPerturbation p;
   p.wrong = static_cast<int>(args.GetInt("wrong", 0));
   p.split = static_cast<int>(args.GetInt("split", 0));
@@ -592,8 +690,12 @@ int RunPerturbLabels(const Args& args) {
   p.seed = static_cast<uint64_t>(args.GetInt("seed", 1));
   int expected = 0;
   st = eval::PerturbLabels(truth, p, &pred, &expected);
-  if (st.ok()) st = eval::WriteLabelFile(args.Get("out"), pred);
-  if (!st.ok()) return Fail(st.message());
+  if (st.ok()) {
+    st = eval::WriteLabelFile(args.Get("out"), pred);
+  }
+  if (!st.ok()) {
+    return Fail(st.message());
+  }
   const double rate =
       truth.empty() ? 0.0 : static_cast<double>(expected) / static_cast<double>(truth.size());
   std::printf("wrote %zu labels to %s with %d known errors (rate %.6f)\n", pred.size(),
@@ -610,16 +712,20 @@ int RunDatasets(const Args& args) {
   Json j = Json::Object();
   j.Set("metric", "datasets").Set("root", eval::DataRoot());
   std::printf("data root: %s\n", eval::DataRoot().c_str());
-  auto report = [&](const std::string& name, const std::string& text, Json info) {
+  auto report = [&](const std::string& name, const std::string& text, const Json& info) {
     std::printf("  %-26s %s\n", name.c_str(), text.c_str());
     j.Set(name, info);
   };
   if (const std::string p = eval::DataSetPath("hopkins155"); !p.empty()) {
     std::vector<eval::TrackSet> sets;
     const Status st = eval::ReadTracksFolder(p, &sets);
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
     std::map<int, int> by_groups;
-    for (const auto& s : sets) ++by_groups[s.NumGroups()];
+    for (const auto& s : sets) {
+      ++by_groups[s.NumGroups()];
+    }
     std::string text = std::to_string(sets.size()) + " sequences (";
     Json info = Json::Object();
     info.Set("sequences", sets.size());
@@ -635,9 +741,13 @@ int RunDatasets(const Args& args) {
   if (const std::string p = eval::DataSetPath("davis2016"); !p.empty()) {
     std::vector<eval::DavisSequence> seqs;
     const Status st = eval::ReadDavis(p, &seqs);
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
     size_t frames = 0;
-    for (const auto& s : seqs) frames += s.masks.size();
+    for (const auto& s : seqs) {
+      frames += s.masks.size();
+    }
     report("davis2016",
            std::to_string(seqs.size()) + " sequences, " + std::to_string(frames) + " masked frames",
            Json::Object().Set("sequences", seqs.size()).Set("frames", frames));
@@ -645,21 +755,27 @@ int RunDatasets(const Args& args) {
   if (const std::string p = eval::DataSetPath("camvid_0016E5_15hz"); !p.empty()) {
     std::vector<eval::CamVidFrame> frames;
     const Status st = eval::ReadCamVid(p, &frames);
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
     report("camvid_0016E5_15hz", std::to_string(frames.size()) + " labelled frames",
            Json::Object().Set("frames", frames.size()));
   }
   if (const std::string p = eval::DataSetPath("tum_fr3_cabinet_subset"); !p.empty()) {
     eval::TumSubset tum;
     const Status st = eval::ReadTumSubset(p, &tum);
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
     report("tum_fr3_cabinet_subset", std::to_string(tum.truth.size()) + " poses and images",
            Json::Object().Set("frames", tum.truth.size()));
   }
   if (const std::string p = eval::DataSetPath("tartanair_indoor_subset"); !p.empty()) {
     eval::TartanAirSubset ta;
     const Status st = eval::ReadTartanAirSubset(p, 1000000, &ta);
-    if (!st.ok()) return Fail(st.message());
+    if (!st.ok()) {
+      return Fail(st.message());
+    }
     double length = 0.0;
     for (size_t i = 1; i < ta.truth.size(); ++i) {
       length += (ta.truth[i].pose.translation - ta.truth[i - 1].pose.translation).norm();
@@ -700,23 +816,50 @@ every subcommand accepts --json FILE and prints one JSON object as its last line
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int Main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
     Usage();
     return argc < 2 ? 2 : 0;
   }
   const std::string cmd = argv[1];
   const Args args(argc, argv, 2);
-  if (cmd == "ate") return RunAte(args);
-  if (cmd == "seg") return RunSeg(args);
-  if (cmd == "masks") return RunMasks(args);
-  if (cmd == "objects") return RunObjects(args);
-  if (cmd == "camvid") return RunCamVid(args);
-  if (cmd == "points") return RunPoints(args);
-  if (cmd == "perturb") return RunPerturb(args);
-  if (cmd == "perturb-labels") return RunPerturbLabels(args);
-  if (cmd == "datasets") return RunDatasets(args);
+  if (cmd == "ate") {
+    return RunAte(args);
+  }
+  if (cmd == "seg") {
+    return RunSeg(args);
+  }
+  if (cmd == "masks") {
+    return RunMasks(args);
+  }
+  if (cmd == "objects") {
+    return RunObjects(args);
+  }
+  if (cmd == "camvid") {
+    return RunCamVid(args);
+  }
+  if (cmd == "points") {
+    return RunPoints(args);
+  }
+  if (cmd == "perturb") {
+    return RunPerturb(args);
+  }
+  if (cmd == "perturb-labels") {
+    return RunPerturbLabels(args);
+  }
+  if (cmd == "datasets") {
+    return RunDatasets(args);
+  }
   std::cerr << "mbslam-eval: unknown subcommand '" << cmd << "'\n";
   Usage();
   return 2;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return Main(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "mbslam-eval: " << e.what() << "\n";
+    return 1;
+  }
 }

@@ -9,8 +9,12 @@ namespace eval {
 std::vector<int> SolveAssignment(const Eigen::MatrixXd& cost, double* total_cost) {
   const int rows = static_cast<int>(cost.rows()), cols = static_cast<int>(cost.cols());
   std::vector<int> row_to_col(static_cast<size_t>(rows), -1);
-  if (total_cost) *total_cost = 0.0;
-  if (rows == 0 || cols == 0) return row_to_col;
+  if (total_cost) {
+    *total_cost = 0.0;
+  }
+  if (rows == 0 || cols == 0) {
+    return row_to_col;
+  }
   // Square problem of size n, padded with zero-cost dummy rows / columns. Indices are
   // 1-based below; index 0 is the virtual column from which each augmenting path starts.
   const int n = std::max(rows, cols);
@@ -31,7 +35,9 @@ std::vector<int> SolveAssignment(const Eigen::MatrixXd& cost, double* total_cost
       double delta = kInf;
       int j1 = 0;
       for (int j = 1; j <= n; ++j) {
-        if (used[static_cast<size_t>(j)]) continue;
+        if (used[static_cast<size_t>(j)]) {
+          continue;
+        }
         const double reduced = a(i0, j) - u[static_cast<size_t>(i0)] - v[static_cast<size_t>(j)];
         if (reduced < min_slack[static_cast<size_t>(j)]) {
           min_slack[static_cast<size_t>(j)] = reduced;
@@ -64,18 +70,22 @@ std::vector<int> SolveAssignment(const Eigen::MatrixXd& cost, double* total_cost
     const int i = match[static_cast<size_t>(j)];
     if (i >= 1 && i <= rows && j <= cols) {
       row_to_col[static_cast<size_t>(i - 1)] = j - 1;
-      if (total_cost) *total_cost += cost(i - 1, j - 1);
+      if (total_cost) {
+        *total_cost += cost(i - 1, j - 1);
+      }
     }
   }
   return row_to_col;
 }
 
 std::vector<int> SolveMaxAssignment(const Eigen::MatrixXd& weight, double* total_weight) {
-  const std::vector<int> assignment = SolveAssignment(-weight);
+  std::vector<int> assignment = SolveAssignment(-weight);
   if (total_weight) {
     *total_weight = 0.0;
     for (size_t i = 0; i < assignment.size(); ++i) {
-      if (assignment[i] >= 0) *total_weight += weight(static_cast<Eigen::Index>(i), assignment[i]);
+      if (assignment[i] >= 0) {
+        *total_weight += weight(static_cast<Eigen::Index>(i), assignment[i]);
+      }
     }
   }
   return assignment;

@@ -22,7 +22,9 @@ double BruteForce(const Eigen::MatrixXd& cost) {
     double total = 0.0;
     for (int i = 0; i < r; ++i) {
       const int j = perm[static_cast<size_t>(i)];
-      if (j < c) total += cost(i, j);
+      if (j < c) {
+        total += cost(i, j);
+      }
     }
     best = std::min(best, total);
   } while (std::next_permutation(perm.begin(), perm.end()));
@@ -37,23 +39,27 @@ TEST(Hungarian, MatchesBruteForceOnRandomRectangularProblems) {
     const int r = size(rng), c = size(rng);
     Eigen::MatrixXd cost(r, c);
     for (int i = 0; i < r; ++i) {
-      for (int j = 0; j < c; ++j)
+      for (int j = 0; j < c; ++j) {
         cost(i, j) = (trial % 3 == 0) ? std::round(value(rng)) : value(rng);
+      }
     }
     double total = 0.0;
     const auto assignment = SolveAssignment(cost, &total);
     // A valid assignment: distinct columns, min(r, c) of them.
     std::vector<int> used;
     for (int j : assignment) {
-      if (j >= 0) used.push_back(j);
+      if (j >= 0) {
+        used.push_back(j);
+      }
     }
     std::sort(used.begin(), used.end());
     EXPECT_EQ(std::unique(used.begin(), used.end()), used.end());
     EXPECT_EQ(static_cast<int>(used.size()), std::min(r, c));
     double check = 0.0;
     for (int i = 0; i < r; ++i) {
-      if (assignment[static_cast<size_t>(i)] >= 0)
+      if (assignment[static_cast<size_t>(i)] >= 0) {
         check += cost(i, assignment[static_cast<size_t>(i)]);
+      }
     }
     EXPECT_NEAR(check, total, 1e-9);
     EXPECT_NEAR(total, BruteForce(cost), 1e-9) << "trial " << trial << "\n" << cost;

@@ -10,11 +10,15 @@ namespace mbslam {
 namespace eval {
 
 Json::Json(const std::vector<double>& values) : type_(Type::kArray) {
-  for (double v : values) array_.emplace_back(v);
+  for (double v : values) {
+    array_.emplace_back(v);
+  }
 }
 
 Json& Json::Set(const std::string& key, Json value) {
-  if (type_ == Type::kNull) type_ = Type::kObject;
+  if (type_ == Type::kNull) {
+    type_ = Type::kObject;
+  }
   for (auto& m : members_) {
     if (m.first == key) {
       m.second = std::move(value);
@@ -26,23 +30,35 @@ Json& Json::Set(const std::string& key, Json value) {
 }
 
 Json& Json::Push(Json value) {
-  if (type_ == Type::kNull) type_ = Type::kArray;
+  if (type_ == Type::kNull) {
+    type_ = Type::kArray;
+  }
   array_.push_back(std::move(value));
   return *this;
 }
 
 const Json* Json::Find(const std::string& key) const {
-  if (type_ != Type::kObject) return nullptr;
+  if (type_ != Type::kObject) {
+    return nullptr;
+  }
   for (const auto& m : members_) {
-    if (m.first == key) return &m.second;
+    if (m.first == key) {
+      return &m.second;
+    }
   }
   return nullptr;
 }
 
 double Json::AsDouble() const {
-  if (type_ == Type::kInt) return static_cast<double>(int_);
-  if (type_ == Type::kDouble) return double_;
-  if (type_ == Type::kBool) return bool_ ? 1.0 : 0.0;
+  if (type_ == Type::kInt) {
+    return static_cast<double>(int_);
+  }
+  if (type_ == Type::kDouble) {
+    return double_;
+  }
+  if (type_ == Type::kBool) {
+    return bool_ ? 1.0 : 0.0;
+  }
   return std::numeric_limits<double>::quiet_NaN();
 }
 
@@ -100,7 +116,9 @@ void Json::DumpTo(std::string* out) const {
         // Shortest of %.15g / %.17g that reads back as the same double.
         char buf[32];
         std::snprintf(buf, sizeof(buf), "%.15g", double_);
-        if (std::strtod(buf, nullptr) != double_) std::snprintf(buf, sizeof(buf), "%.17g", double_);
+        if (std::strtod(buf, nullptr) != double_) {
+          std::snprintf(buf, sizeof(buf), "%.17g", double_);
+        }
         *out += buf;
       }
       break;
@@ -111,7 +129,9 @@ void Json::DumpTo(std::string* out) const {
     case Type::kArray:
       out->push_back('[');
       for (size_t i = 0; i < array_.size(); ++i) {
-        if (i) *out += ", ";
+        if (i) {
+          *out += ", ";
+        }
         array_[i].DumpTo(out);
       }
       out->push_back(']');
@@ -119,7 +139,9 @@ void Json::DumpTo(std::string* out) const {
     case Type::kObject:
       out->push_back('{');
       for (size_t i = 0; i < members_.size(); ++i) {
-        if (i) *out += ", ";
+        if (i) {
+          *out += ", ";
+        }
         AppendEscaped(members_[i].first, out);
         *out += ": ";
         members_[i].second.DumpTo(out);
@@ -143,27 +165,37 @@ class Parser {
 
   bool ParseDocument(Json* out, std::string* error) {
     const bool ok = ParseValue(out) && (SkipSpace(), pos_ == s_.size());
-    if (!ok && error) *error = "JSON parse error at offset " + std::to_string(pos_);
+    if (!ok && error) {
+      *error = "JSON parse error at offset " + std::to_string(pos_);
+    }
     return ok;
   }
 
  private:
   void SkipSpace() {
-    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) {
+      ++pos_;
+    }
   }
   bool Literal(const char* lit) {
     const std::string l(lit);
-    if (s_.compare(pos_, l.size(), l) != 0) return false;
+    if (s_.compare(pos_, l.size(), l) != 0) {
+      return false;
+    }
     pos_ += l.size();
     return true;
   }
   bool ParseString(std::string* out) {
-    if (pos_ >= s_.size() || s_[pos_] != '"') return false;
+    if (pos_ >= s_.size() || s_[pos_] != '"') {
+      return false;
+    }
     ++pos_;
     while (pos_ < s_.size() && s_[pos_] != '"') {
       char c = s_[pos_++];
       if (c == '\\') {
-        if (pos_ >= s_.size()) return false;
+        if (pos_ >= s_.size()) {
+          return false;
+        }
         const char e = s_[pos_++];
         switch (e) {
           case 'n':
@@ -182,7 +214,9 @@ class Parser {
             c = '\f';
             break;
           case 'u': {
-            if (pos_ + 4 > s_.size()) return false;
+            if (pos_ + 4 > s_.size()) {
+              return false;
+            }
             c = static_cast<char>(std::strtol(s_.substr(pos_, 4).c_str(), nullptr, 16));
             pos_ += 4;
             break;
@@ -193,35 +227,49 @@ class Parser {
       }
       out->push_back(c);
     }
-    if (pos_ >= s_.size()) return false;
+    if (pos_ >= s_.size()) {
+      return false;
+    }
     ++pos_;
     return true;
   }
   bool ParseValue(Json* out) {
     SkipSpace();
-    if (pos_ >= s_.size()) return false;
+    if (pos_ >= s_.size()) {
+      return false;
+    }
     const char c = s_[pos_];
     if (c == '{') {
       ++pos_;
       *out = Json::Object();
       SkipSpace();
-      if (pos_ < s_.size() && s_[pos_] == '}') return ++pos_, true;
+      if (pos_ < s_.size() && s_[pos_] == '}') {
+        return ++pos_, true;
+      }
       while (true) {
         SkipSpace();
         std::string key;
-        if (!ParseString(&key)) return false;
+        if (!ParseString(&key)) {
+          return false;
+        }
         SkipSpace();
-        if (pos_ >= s_.size() || s_[pos_] != ':') return false;
+        if (pos_ >= s_.size() || s_[pos_] != ':') {
+          return false;
+        }
         ++pos_;
         Json value;
-        if (!ParseValue(&value)) return false;
+        if (!ParseValue(&value)) {
+          return false;
+        }
         out->Set(key, std::move(value));
         SkipSpace();
         if (pos_ < s_.size() && s_[pos_] == ',') {
           ++pos_;
           continue;
         }
-        if (pos_ < s_.size() && s_[pos_] == '}') return ++pos_, true;
+        if (pos_ < s_.size() && s_[pos_] == '}') {
+          return ++pos_, true;
+        }
         return false;
       }
     }
@@ -229,33 +277,49 @@ class Parser {
       ++pos_;
       *out = Json::Array();
       SkipSpace();
-      if (pos_ < s_.size() && s_[pos_] == ']') return ++pos_, true;
+      if (pos_ < s_.size() && s_[pos_] == ']') {
+        return ++pos_, true;
+      }
       while (true) {
         Json value;
-        if (!ParseValue(&value)) return false;
+        if (!ParseValue(&value)) {
+          return false;
+        }
         out->Push(std::move(value));
         SkipSpace();
         if (pos_ < s_.size() && s_[pos_] == ',') {
           ++pos_;
           continue;
         }
-        if (pos_ < s_.size() && s_[pos_] == ']') return ++pos_, true;
+        if (pos_ < s_.size() && s_[pos_] == ']') {
+          return ++pos_, true;
+        }
         return false;
       }
     }
     if (c == '"') {
       std::string str;
-      if (!ParseString(&str)) return false;
+      if (!ParseString(&str)) {
+        return false;
+      }
       *out = Json(std::move(str));
       return true;
     }
-    if (Literal("true")) return *out = Json(true), true;
-    if (Literal("false")) return *out = Json(false), true;
-    if (Literal("null")) return *out = Json(), true;
+    if (Literal("true")) {
+      return *out = Json(true), true;
+    }
+    if (Literal("false")) {
+      return *out = Json(false), true;
+    }
+    if (Literal("null")) {
+      return *out = Json(), true;
+    }
     const char* begin = s_.c_str() + pos_;
     char* end = nullptr;
     const double v = std::strtod(begin, &end);
-    if (end == begin) return false;
+    if (end == begin) {
+      return false;
+    }
     const std::string token(begin, static_cast<size_t>(end - begin));
     pos_ += token.size();
     if (token.find_first_of(".eE") == std::string::npos) {

@@ -26,21 +26,29 @@ Status ReadCameraPoseLog(const std::string& path, const std::string& channel, Ca
   *log = CameraPoseLog();
   Status status;
   auto reader = LcmLogReader::Open(path, &status);
-  if (!reader) return status;
+  if (!reader) {
+    return status;
+  }
   LcmLogEvent e;
   while (reader->Next(&e)) {
-    if (e.channel != channel) continue;
+    if (e.channel != channel) {
+      continue;
+    }
     mbslam::camera_pose_t msg{};
     if (!Decode(e, &msg)) {
       ++log->num_undecodable;
       continue;
     }
     ++log->num_messages;
-    if (msg.scale_state == mbslam::camera_pose_t::SCALE_METRIC) ++log->num_metric;
+    if (msg.scale_state == mbslam::camera_pose_t::SCALE_METRIC) {
+      ++log->num_metric;
+    }
     if (msg.tracking_state == mbslam::camera_pose_t::TRACKING_OK ||
         msg.tracking_state == mbslam::camera_pose_t::TRACKING_RELOCALIZED) {
       const Rigid3d pose = MessagePose(msg.position, msg.orientation);
-      if (pose.IsFinite()) log->tracked.push_back({msg.utime, pose});
+      if (pose.IsFinite()) {
+        log->tracked.push_back({msg.utime, pose});
+      }
     }
   }
   SortByTime(&log->tracked);
@@ -52,16 +60,23 @@ Status ReadGroundTruthLog(const std::string& path, const std::string& channel,
   *log = GroundTruthLog();
   Status status;
   auto reader = LcmLogReader::Open(path, &status);
-  if (!reader) return status;
+  if (!reader) {
+    return status;
+  }
   LcmLogEvent e;
   while (reader->Next(&e)) {
-    if (e.channel != channel) continue;
+    if (e.channel != channel) {
+      continue;
+    }
     mbslam::ground_truth_t msg{};
-    if (!Decode(e, &msg)) return Status::Error(path + ": undecodable ground_truth_t on " + channel);
+    if (!Decode(e, &msg)) {
+      return Status::Error(path + ": undecodable ground_truth_t on " + channel);
+    }
     ++log->num_messages;
     log->source = msg.source;
-    if (msg.has_camera)
+    if (msg.has_camera) {
       log->camera.push_back({msg.utime, MessagePose(msg.cam_position, msg.cam_orientation)});
+    }
     for (const auto& b : msg.bodies) {
       BodyTruth& body = log->bodies[b.id];
       body.id = b.id;
@@ -71,25 +86,38 @@ Status ReadGroundTruthLog(const std::string& path, const std::string& channel,
     }
   }
   SortByTime(&log->camera);
-  for (auto& b : log->bodies) SortByTime(&b.second.poses);
-  if (log->num_messages == 0)
+  for (auto& b : log->bodies) {
+    SortByTime(&b.second.poses);
+  }
+  if (log->num_messages == 0) {
     return Status::Error(path + ": no ground_truth_t on channel " + channel);
+  }
   return Status::Ok();
 }
 
 Status ReadObjectsLog(const std::string& path, const std::string& channel,
                       std::map<int, ObjectEstimate>* objects, int* num_messages) {
   objects->clear();
-  if (num_messages) *num_messages = 0;
+  if (num_messages) {
+    *num_messages = 0;
+  }
   Status status;
   auto reader = LcmLogReader::Open(path, &status);
-  if (!reader) return status;
+  if (!reader) {
+    return status;
+  }
   LcmLogEvent e;
   while (reader->Next(&e)) {
-    if (e.channel != channel) continue;
+    if (e.channel != channel) {
+      continue;
+    }
     mbslam::objects_t msg{};
-    if (!Decode(e, &msg)) return Status::Error(path + ": undecodable objects_t on " + channel);
-    if (num_messages) ++*num_messages;
+    if (!Decode(e, &msg)) {
+      return Status::Error(path + ": undecodable objects_t on " + channel);
+    }
+    if (num_messages) {
+      ++*num_messages;
+    }
     for (const auto& o : msg.objects) {
       ObjectEstimate& est = (*objects)[o.id];
       est.id = o.id;
@@ -119,10 +147,14 @@ Status CountLogEvents(const std::string& path, const std::string& channel, int* 
   *count = 0;
   Status status;
   auto reader = LcmLogReader::Open(path, &status);
-  if (!reader) return status;
+  if (!reader) {
+    return status;
+  }
   LcmLogEvent e;
   while (reader->Next(&e)) {
-    if (e.channel == channel) ++*count;
+    if (e.channel == channel) {
+      ++*count;
+    }
   }
   return Status::Ok();
 }

@@ -16,7 +16,9 @@ namespace eval {
 namespace {
 
 void SetPose(const Rigid3d& p, double position[3], double orientation[4]) {
-  for (int i = 0; i < 3; ++i) position[i] = p.translation[i];
+  for (int i = 0; i < 3; ++i) {
+    position[i] = p.translation[i];
+  }
   orientation[0] = p.rotation.w();
   orientation[1] = p.rotation.x();
   orientation[2] = p.rotation.y();

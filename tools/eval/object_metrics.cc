@@ -15,17 +15,23 @@ bool PredictedVolume::Contains(const Eigen::Vector3d& point) const {
 }
 
 bool InterpolatePose(const Trajectory& poses, int64_t utime, int64_t max_gap_us, Rigid3d* pose) {
-  if (poses.empty()) return false;
+  if (poses.empty()) {
+    return false;
+  }
   auto it = std::lower_bound(poses.begin(), poses.end(), utime,
                              [](const TimedPose& p, int64_t t) { return p.utime < t; });
   if (it != poses.end() && it->utime == utime) {
     *pose = it->pose;
     return true;
   }
-  if (it == poses.begin() || it == poses.end()) return false;
+  if (it == poses.begin() || it == poses.end()) {
+    return false;
+  }
   const TimedPose& b = *it;
   const TimedPose& a = *std::prev(it);
-  if (b.utime - a.utime > max_gap_us) return false;
+  if (b.utime - a.utime > max_gap_us) {
+    return false;
+  }
   *pose = Rigid3d::Interpolate(
       a.pose, b.pose,
       static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime));
@@ -41,7 +47,9 @@ bool TruthAt(const Trajectory& poses, int64_t utime, int64_t tolerance, Rigid3d*
                              [](const TimedPose& p, int64_t t) { return p.utime < t; });
   int64_t best = std::numeric_limits<int64_t>::max();
   for (auto jt : {it, it == poses.begin() ? poses.end() : std::prev(it)}) {
-    if (jt == poses.end()) continue;
+    if (jt == poses.end()) {
+      continue;
+    }
     const int64_t dt = std::llabs(jt->utime - utime);
     if (dt <= tolerance && dt < best) {
       best = dt;
@@ -90,14 +98,20 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
                        const std::map<int, BodyTruth>& truth, const Trajectory& gt_camera,
                        const Sim3d& gt_from_est, const ObjectMetricsOptions& options,
                        ObjectsEvaluation* result) {
-  if (!options.Check()) return Status::Error("object metrics options: " + LastOptionError());
+  if (!options.Check()) {
+    return Status::Error("object metrics options: " + LastOptionError());
+  }
   *result = ObjectsEvaluation();
   result->num_est_objects = static_cast<int>(estimates.size());
   result->num_gt_bodies = static_cast<int>(truth.size());
   std::vector<const ObjectEstimate*> est_list;
   std::vector<const BodyTruth*> gt_list;
-  for (const auto& e : estimates) est_list.push_back(&e.second);
-  for (const auto& t : truth) gt_list.push_back(&t.second);
+  for (const auto& e : estimates) {
+    est_list.push_back(&e.second);
+  }
+  for (const auto& t : truth) {
+    gt_list.push_back(&t.second);
+  }
   // Association: mean distance over common samples, gated, Hungarian.
   const double kForbidden = 1e9;
   Eigen::MatrixXd cost =
@@ -107,9 +121,13 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     for (size_t j = 0; j < gt_list.size(); ++j) {
       const auto common = CommonSamples(*est_list[i], *gt_list[j], gt_camera, gt_from_est,
                                         options.max_time_diff_us);
-      if (static_cast<int>(common.size()) < options.min_samples) continue;
+      if (static_cast<int>(common.size()) < options.min_samples) {
+        continue;
+      }
       double sum = 0.0;
-      for (const auto& c : common) sum += (c.est - c.truth).norm();
+      for (const auto& c : common) {
+        sum += (c.est - c.truth).norm();
+      }
       const double mean = sum / static_cast<double>(common.size());
       if (mean <= options.max_match_distance) {
         cost(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = mean;
@@ -155,12 +173,17 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     const Sim3d est_from_gt = gt_from_est.Inverse();
     for (const auto& s : est.samples) {
       for (const auto& v : s.volumes) {
-        if (std::llabs(v.horizon_us - options.horizon_us) > options.horizon_tolerance_us) continue;
+        if (std::llabs(v.horizon_us - options.horizon_us) > options.horizon_tolerance_us) {
+          continue;
+        }
         Rigid3d body_pose;
-        if (!InterpolatePose(body.poses, v.utime, 1000000, &body_pose))
+        if (!InterpolatePose(body.poses, v.utime, 1000000, &body_pose)) {
           continue;  // beyond the truth
+        }
         ++r.volumes_checked;
-        if (v.Contains(est_from_gt * body_pose.translation)) ++r.volumes_hit;
+        if (v.Contains(est_from_gt * body_pose.translation)) {
+          ++r.volumes_hit;
+        }
       }
     }
     r.hit_rate =

@@ -14,14 +14,20 @@ namespace eval {
 Status PerturbTrajectory(const Trajectory& gt, const TrajectoryPerturbation& p, Trajectory* est,
                          double* expected_ate_m) {
   const size_t n = gt.size();
-  if (n < 3) return Status::Error("perturb: needs at least 3 poses");
+  if (n < 3) {
+    return Status::Error("perturb: needs at least 3 poses");
+  }
   std::mt19937_64 rng(p.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   Eigen::VectorXd noise(3 * static_cast<Eigen::Index>(n));
-  for (Eigen::Index i = 0; i < noise.size(); ++i) noise(i) = p.noise_sigma_m * normal(rng);
+  for (Eigen::Index i = 0; i < noise.size(); ++i) {
+    noise(i) = p.noise_sigma_m * normal(rng);
+  }
 
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& g : gt) mean += g.pose.translation;
+  for (const auto& g : gt) {
+    mean += g.pose.translation;
+  }
   mean /= static_cast<double>(n);
   if (p.exact && p.noise_sigma_m > 0.0) {
     // Remove every component a similarity could explain: translations (3), rotations
@@ -62,12 +68,16 @@ Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p,
                      std::vector<int>* predicted, int* expected_errors) {
   std::mt19937_64 rng(p.seed);
   std::map<int, std::vector<size_t>> groups;
-  for (size_t i = 0; i < truth.size(); ++i) groups[truth[i]].push_back(i);
+  for (size_t i = 0; i < truth.size(); ++i) {
+    groups[truth[i]].push_back(i);
+  }
   if (groups.size() < 2 && (p.wrong > 0 || p.merge_smallest)) {
     return Status::Error("perturb labels: needs at least 2 groups");
   }
   std::vector<int> order;  // group labels, smallest group first
-  for (const auto& g : groups) order.push_back(g.first);
+  for (const auto& g : groups) {
+    order.push_back(g.first);
+  }
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return groups[a].size() < groups[b].size(); });
   *predicted = truth;
@@ -76,11 +86,19 @@ Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p,
   std::vector<int> movable_groups(order.begin(), order.end());
   int merged_into = -1;
   if (p.merge_smallest) {
-    if (groups.size() < 3) return Status::Error("perturb labels: merging needs at least 3 groups");
+    if (groups.size() < 3) {
+      return Status::Error("perturb labels: merging needs at least 3 groups");
+    }
     const int small = order[0], other = order[1];
-    for (size_t i : groups[small]) (*predicted)[i] = other;
-    for (size_t i : groups[small]) locked[i] = true;
-    for (size_t i : groups[other]) locked[i] = true;
+    for (size_t i : groups[small]) {
+      (*predicted)[i] = other;
+    }
+    for (size_t i : groups[small]) {
+      locked[i] = true;
+    }
+    for (size_t i : groups[other]) {
+      locked[i] = true;
+    }
     errors += static_cast<int>(groups[small].size());
     merged_into = other;
     movable_groups.erase(movable_groups.begin(), movable_groups.begin() + 2);
@@ -101,11 +119,13 @@ Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p,
     errors += p.split;
   }
   if (p.wrong > 0) {
-    if (movable_groups.size() < 2)
+    if (movable_groups.size() < 2) {
       return Status::Error("perturb labels: too few groups left to move points between");
+    }
     size_t smallest = truth.size();
-    for (int g : movable_groups)
+    for (int g : movable_groups) {
       smallest = std::min(smallest, groups[g].size() - (g == order.back() ? p.split : 0));
+    }
     if (2 * (p.wrong + p.split) >= static_cast<int>(smallest)) {
       return Status::Error(
           "perturb labels: too many wrong labels for the group sizes (the best matching could "
@@ -114,7 +134,9 @@ Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p,
     std::vector<size_t> candidates;
     for (int g : movable_groups) {
       for (size_t i : groups[g]) {
-        if (!locked[i]) candidates.push_back(i);
+        if (!locked[i]) {
+          candidates.push_back(i);
+        }
       }
     }
     std::shuffle(candidates.begin(), candidates.end(), rng);
@@ -122,7 +144,9 @@ Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p,
       const size_t i = candidates[static_cast<size_t>(k)];
       std::vector<int> others;
       for (int g : movable_groups) {
-        if (g != truth[i]) others.push_back(g);
+        if (g != truth[i]) {
+          others.push_back(g);
+        }
       }
       (*predicted)[i] = others[std::uniform_int_distribution<size_t>(0, others.size() - 1)(rng)];
     }
@@ -131,14 +155,20 @@ Status PerturbLabels(const std::vector<int>& truth, const LabelPerturbation& p,
   if (p.permute) {
     std::vector<int> values;
     for (int v : *predicted) {
-      if (std::find(values.begin(), values.end(), v) == values.end()) values.push_back(v);
+      if (std::find(values.begin(), values.end(), v) == values.end()) {
+        values.push_back(v);
+      }
     }
     std::vector<int> shuffled(values.size());
     std::iota(shuffled.begin(), shuffled.end(), 100);
     std::shuffle(shuffled.begin(), shuffled.end(), rng);
     std::map<int, int> relabel;
-    for (size_t k = 0; k < values.size(); ++k) relabel[values[k]] = shuffled[k];
-    for (int& v : *predicted) v = relabel[v];
+    for (size_t k = 0; k < values.size(); ++k) {
+      relabel[values[k]] = shuffled[k];
+    }
+    for (int& v : *predicted) {
+      v = relabel[v];
+    }
   }
   *expected_errors = errors;
   return Status::Ok();

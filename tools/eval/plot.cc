@@ -17,7 +17,9 @@ double NiceStep(double range, int lines) {
   const double raw = range / std::max(1, lines);
   const double p = std::pow(10.0, std::floor(std::log10(raw)));
   for (double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (m * p >= raw) return m * p;
+    if (m * p >= raw) {
+      return m * p;
+    }
   }
   return 10.0 * p;
 }
@@ -26,11 +28,15 @@ double NiceStep(double range, int lines) {
 
 Status DrawTopView(const Trajectory& gt, const Trajectory& est_aligned, const TopViewPlot& o,
                    cv::Mat* image) {
-  if (gt.empty() && est_aligned.empty()) return Status::Error("plot: nothing to draw");
+  if (gt.empty() && est_aligned.empty()) {
+    return Status::Error("plot: nothing to draw");
+  }
   // Plane of the ground truth's two main directions (PCA); fall back to the estimate.
   const Trajectory& ref = gt.size() >= 2 ? gt : est_aligned;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : ref) mean += p.pose.translation;
+  for (const auto& p : ref) {
+    mean += p.pose.translation;
+  }
   mean /= static_cast<double>(ref.size());
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (const auto& p : ref) {
@@ -47,8 +53,12 @@ Status DrawTopView(const Trajectory& gt, const Trajectory& est_aligned, const To
     return Eigen::Vector2d((p - mean).dot(e1), (p - mean).dot(e2));
   };
   Eigen::AlignedBox2d box;
-  for (const auto& p : gt) box.extend(to2d(p.pose.translation));
-  for (const auto& p : est_aligned) box.extend(to2d(p.pose.translation));
+  for (const auto& p : gt) {
+    box.extend(to2d(p.pose.translation));
+  }
+  for (const auto& p : est_aligned) {
+    box.extend(to2d(p.pose.translation));
+  }
   const double extent = std::max({box.sizes().x(), box.sizes().y(), 1e-3});
   box.min() -= Eigen::Vector2d::Constant(0.08 * extent);
   box.max() += Eigen::Vector2d::Constant(0.08 * extent);
@@ -86,8 +96,9 @@ Status DrawTopView(const Trajectory& gt, const Trajectory& est_aligned, const To
       if (it == gt.end() || it->utime != e.utime) {
         // nearest in time
         if (it == gt.end() ||
-            (it != gt.begin() && e.utime - std::prev(it)->utime < it->utime - e.utime))
+            (it != gt.begin() && e.utime - std::prev(it)->utime < it->utime - e.utime)) {
           --it;
+        }
       }
       cv::line(*image, fixed(px(e.pose.translation)), fixed(px(it->pose.translation)),
                cv::Scalar(190, 190, 190), 1, cv::LINE_AA, shift);
@@ -98,9 +109,10 @@ Status DrawTopView(const Trajectory& gt, const Trajectory& est_aligned, const To
       cv::line(*image, fixed(px(t[i - 1].pose.translation)), fixed(px(t[i].pose.translation)),
                color, 2, cv::LINE_AA, shift);
     }
-    if (!t.empty())
+    if (!t.empty()) {
       cv::circle(*image, fixed(px(t.front().pose.translation)), 5 * 16, color, 2, cv::LINE_AA,
                  shift);
+    }
   };
   const cv::Scalar green(40, 160, 40), red(40, 40, 220);
   polyline(gt, green);
@@ -126,7 +138,9 @@ Status WriteTopView(const std::string& path, const Trajectory& gt, const Traject
   cv::Mat image;
   MBSLAM_RETURN_IF_ERROR(DrawTopView(gt, est_aligned, options, &image));
   try {
-    if (!cv::imwrite(path, image)) return Status::Error("cannot write " + path);
+    if (!cv::imwrite(path, image)) {
+      return Status::Error("cannot write " + path);
+    }
   } catch (const cv::Exception& e) {
     return Status::Error("cannot write " + path + ": " + e.what());
   }

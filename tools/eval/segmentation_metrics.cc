@@ -16,30 +16,45 @@ MisclassificationResult Misclassification(const std::vector<int>& predicted,
   r.num_points = static_cast<int>(n);
   std::map<int, int> pred_index, true_index;
   for (size_t i = 0; i < n; ++i) {
-    if (predicted[i] >= 0) pred_index.emplace(predicted[i], 0);
+    if (predicted[i] >= 0) {
+      pred_index.emplace(predicted[i], 0);
+    }
     true_index.emplace(truth[i], 0);
   }
   int k = 0;
-  for (auto& p : pred_index) p.second = k++;
+  for (auto& p : pred_index) {
+    p.second = k++;
+  }
   k = 0;
-  for (auto& t : true_index) t.second = k++;
+  for (auto& t : true_index) {
+    t.second = k++;
+  }
   r.num_pred_groups = static_cast<int>(pred_index.size());
   r.num_true_groups = static_cast<int>(true_index.size());
-  if (n == 0) return r;
+  if (n == 0) {
+    return r;
+  }
   // Contingency table: points of predicted group p in true group t.
   Eigen::MatrixXd counts = Eigen::MatrixXd::Zero(r.num_pred_groups, r.num_true_groups);
   for (size_t i = 0; i < n; ++i) {
-    if (predicted[i] < 0) continue;
+    if (predicted[i] < 0) {
+      continue;
+    }
     counts(pred_index[predicted[i]], true_index[truth[i]]) += 1.0;
   }
   double matched = 0.0;
   const std::vector<int> assignment = SolveMaxAssignment(counts, &matched);
   std::vector<int> pred_labels(pred_index.size()), true_labels(true_index.size());
-  for (const auto& p : pred_index) pred_labels[static_cast<size_t>(p.second)] = p.first;
-  for (const auto& t : true_index) true_labels[static_cast<size_t>(t.second)] = t.first;
+  for (const auto& p : pred_index) {
+    pred_labels[static_cast<size_t>(p.second)] = p.first;
+  }
+  for (const auto& t : true_index) {
+    true_labels[static_cast<size_t>(t.second)] = t.first;
+  }
   for (size_t p = 0; p < assignment.size(); ++p) {
-    if (assignment[p] >= 0)
+    if (assignment[p] >= 0) {
       r.pred_to_true[pred_labels[p]] = true_labels[static_cast<size_t>(assignment[p])];
+    }
   }
   r.num_errors = r.num_points - static_cast<int>(std::lround(matched));
   r.rate = static_cast<double>(r.num_errors) / static_cast<double>(r.num_points);
@@ -67,27 +82,30 @@ PrecisionRecall MovingFeaturePrecisionRecall(const std::vector<LabelledFeature>&
   PrecisionRecall pr;
   for (const auto& f : features) {
     const int x = static_cast<int>(std::lround(f.u)), y = static_cast<int>(std::lround(f.v));
-    if (x < 0 || y < 0 || x >= mask.cols || y >= mask.rows) continue;
+    if (x < 0 || y < 0 || x >= mask.cols || y >= mask.rows) {
+      continue;
+    }
     bool inside = false;
     switch (mask.depth()) {
       case CV_8U:
-        inside = mask.ptr<uint8_t>(y)[x * mask.channels()] != 0;
+        inside = mask.ptr<uint8_t>(y)[static_cast<ptrdiff_t>(x) * mask.channels()] != 0;
         break;
       case CV_16U:
-        inside = mask.ptr<uint16_t>(y)[x * mask.channels()] != 0;
+        inside = mask.ptr<uint16_t>(y)[static_cast<ptrdiff_t>(x) * mask.channels()] != 0;
         break;
       default:
         inside = mask.at<float>(y, x) != 0.0f;
         break;
     }
-    if (f.moving && inside)
+    if (f.moving && inside) {
       ++pr.true_positives;
-    else if (f.moving && !inside)
+    } else if (f.moving && !inside) {
       ++pr.false_positives;
-    else if (!f.moving && inside)
+    } else if (!f.moving && inside) {
       ++pr.false_negatives;
-    else
+    } else {
       ++pr.true_negatives;
+    }
   }
   pr.Finish();
   return pr;
@@ -96,8 +114,12 @@ PrecisionRecall MovingFeaturePrecisionRecall(const std::vector<LabelledFeature>&
 double RegionIoU(const cv::Mat& predicted, const cv::Mat& truth) {
   CV_Assert(predicted.size() == truth.size());
   cv::Mat a = predicted, b = truth;
-  if (a.channels() > 1) cv::cvtColor(a, a, cv::COLOR_BGR2GRAY);
-  if (b.channels() > 1) cv::cvtColor(b, b, cv::COLOR_BGR2GRAY);
+  if (a.channels() > 1) {
+    cv::cvtColor(a, a, cv::COLOR_BGR2GRAY);
+  }
+  if (b.channels() > 1) {
+    cv::cvtColor(b, b, cv::COLOR_BGR2GRAY);
+  }
   const cv::Mat pa = a != 0, pb = b != 0;
   const int inter = cv::countNonZero(pa & pb);
   const int uni = cv::countNonZero(pa | pb);
@@ -107,10 +129,15 @@ double RegionIoU(const cv::Mat& predicted, const cv::Mat& truth) {
 cv::Mat RasterizePolygons(const std::vector<std::vector<cv::Point2f>>& polygons, cv::Size size) {
   cv::Mat mask(size, CV_8UC1, cv::Scalar(0));
   for (const auto& poly : polygons) {
-    if (poly.size() < 3) continue;
+    if (poly.size() < 3) {
+      continue;
+    }
     // Fixed point with 4 fractional bits for sub-pixel vertices.
     std::vector<cv::Point> pts;
-    for (const auto& p : poly) pts.emplace_back(cvRound(p.x * 16.0f), cvRound(p.y * 16.0f));
+    pts.reserve(poly.size());
+    for (const auto& p : poly) {
+      pts.emplace_back(cvRound(p.x * 16.0f), cvRound(p.y * 16.0f));
+    }
     cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{pts}, cv::Scalar(255), cv::LINE_8, 4);
   }
   return mask;

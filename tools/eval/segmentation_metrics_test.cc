@@ -19,8 +19,9 @@ namespace {
 
 std::vector<int> Groups(const std::vector<int>& sizes) {
   std::vector<int> labels;
-  for (size_t g = 0; g < sizes.size(); ++g)
+  for (size_t g = 0; g < sizes.size(); ++g) {
     labels.insert(labels.end(), static_cast<size_t>(sizes[g]), static_cast<int>(g + 1));
+  }
   return labels;
 }
 
@@ -29,11 +30,14 @@ std::vector<int> Groups(const std::vector<int>& sizes) {
 int BruteForceErrors(const std::vector<int>& pred, const std::vector<int>& truth) {
   std::vector<int> p_labels, t_labels;
   for (int v : pred) {
-    if (v >= 0 && std::find(p_labels.begin(), p_labels.end(), v) == p_labels.end())
+    if (v >= 0 && std::find(p_labels.begin(), p_labels.end(), v) == p_labels.end()) {
       p_labels.push_back(v);
+    }
   }
   for (int v : truth) {
-    if (std::find(t_labels.begin(), t_labels.end(), v) == t_labels.end()) t_labels.push_back(v);
+    if (std::find(t_labels.begin(), t_labels.end(), v) == t_labels.end()) {
+      t_labels.push_back(v);
+    }
   }
   const size_t n = std::max(p_labels.size(), t_labels.size());
   std::vector<int> perm(n);
@@ -42,12 +46,15 @@ int BruteForceErrors(const std::vector<int>& pred, const std::vector<int>& truth
   do {
     int correct = 0;
     for (size_t i = 0; i < pred.size(); ++i) {
-      if (pred[i] < 0) continue;
+      if (pred[i] < 0) {
+        continue;
+      }
       const size_t pi = static_cast<size_t>(std::find(p_labels.begin(), p_labels.end(), pred[i]) -
                                             p_labels.begin());
       const int t = perm[pi];
-      if (t < static_cast<int>(t_labels.size()) && t_labels[static_cast<size_t>(t)] == truth[i])
+      if (t < static_cast<int>(t_labels.size()) && t_labels[static_cast<size_t>(t)] == truth[i]) {
         ++correct;
+      }
     }
     best = std::max(best, correct);
   } while (std::next_permutation(perm.begin(), perm.end()));
@@ -57,7 +64,9 @@ int BruteForceErrors(const std::vector<int>& pred, const std::vector<int>& truth
 TEST(Misclassification, PerfectUnderAnyPermutation) {
   const std::vector<int> truth = Groups({40, 25, 10});
   std::vector<int> pred = truth;
-  for (int& v : pred) v = (v == 1) ? 7 : (v == 2 ? 3 : 5);
+  for (int& v : pred) {
+    v = (v == 1) ? 7 : (v == 2 ? 3 : 5);
+  }
   const auto r = Misclassification(pred, truth);
   EXPECT_EQ(r.num_errors, 0);
   EXPECT_DOUBLE_EQ(r.rate, 0.0);

@@ -20,14 +20,20 @@ std::vector<std::string> Tokens(const std::string& line) {
   std::vector<std::string> out;
   std::string cur;
   for (char c : line) {
-    if (c == '#') break;
+    if (c == '#') {
+      break;
+    }
     if (c == ' ' || c == '\t' || c == ',' || c == '\r') {
-      if (!cur.empty()) out.push_back(cur), cur.clear();
+      if (!cur.empty()) {
+        out.push_back(cur), cur.clear();
+      }
     } else {
       cur.push_back(c);
     }
   }
-  if (!cur.empty()) out.push_back(cur);
+  if (!cur.empty()) {
+    out.push_back(cur);
+  }
   return out;
 }
 
@@ -56,16 +62,22 @@ std::string UtimeToSecondsString(int64_t utime) {
 }
 
 bool ParseSecondsToUtime(const std::string& token, int64_t* utime) {
-  if (token.empty()) return false;
+  if (token.empty()) {
+    return false;
+  }
   size_t i = 0;
   bool negative = false;
-  if (token[i] == '+' || token[i] == '-') negative = token[i++] == '-';
+  if (token[i] == '+' || token[i] == '-') {
+    negative = token[i++] == '-';
+  }
   int64_t whole = 0;
   size_t digits = 0;
   while (i < token.size() && std::isdigit(static_cast<unsigned char>(token[i]))) {
     whole = whole * 10 + (token[i++] - '0');
     ++digits;
-    if (digits > 12) break;
+    if (digits > 12) {
+      break;
+    }
   }
   int64_t frac = 0;
   int frac_digits = 0;
@@ -86,11 +98,15 @@ bool ParseSecondsToUtime(const std::string& token, int64_t* utime) {
   if (i != token.size() || (digits == 0 && frac_digits == 0) || digits > 12) {
     // Exponent or very large: fall back to floating point.
     double v;
-    if (!ParseDouble(token, &v) || !std::isfinite(v)) return false;
+    if (!ParseDouble(token, &v) || !std::isfinite(v)) {
+      return false;
+    }
     *utime = static_cast<int64_t>(std::llround(v * 1e6));
     return true;
   }
-  for (int k = std::min(frac_digits, 6); k < 6; ++k) frac *= 10;
+  for (int k = std::min(frac_digits, 6); k < 6; ++k) {
+    frac *= 10;
+  }
   int64_t us = whole * 1000000 + frac + (round_up ? 1 : 0);
   *utime = negative ? -us : us;
   return true;
@@ -109,7 +125,9 @@ Status ParseTumTrajectory(const std::string& text, Trajectory* trajectory) {
   while (std::getline(in, line)) {
     ++line_no;
     const auto tokens = Tokens(line);
-    if (tokens.empty()) continue;
+    if (tokens.empty()) {
+      continue;
+    }
     if (tokens.size() != 8) {
       return Status::Error("line " + std::to_string(line_no) +
                            ": expected 8 values (t tx ty tz qx qy qz qw), got " +
@@ -122,13 +140,15 @@ Status ParseTumTrajectory(const std::string& text, Trajectory* trajectory) {
     }
     double v[7];
     for (int k = 0; k < 7; ++k) {
-      if (!ParseDouble(tokens[static_cast<size_t>(k + 1)], &v[k]) || !std::isfinite(v[k])) {
-        return Status::Error("line " + std::to_string(line_no) + ": bad number '" +
-                             tokens[static_cast<size_t>(k + 1)] + "'");
+      const std::string& token = tokens[static_cast<size_t>(k) + 1];
+      if (!ParseDouble(token, &v[k]) || !std::isfinite(v[k])) {
+        return Status::Error("line " + std::to_string(line_no) + ": bad number '" + token + "'");
       }
     }
     const double qn = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
-    if (qn < 1e-6) return Status::Error("line " + std::to_string(line_no) + ": zero quaternion");
+    if (qn < 1e-6) {
+      return Status::Error("line " + std::to_string(line_no) + ": zero quaternion");
+    }
     p.pose = PoseFromXyzQxyzw(v);
     trajectory->push_back(p);
   }
@@ -159,9 +179,13 @@ std::string FormatTumLine(int64_t utime, const Rigid3d& pose) {
 Status WriteTumTrajectory(const std::string& path, const Trajectory& trajectory,
                           const std::string& header_comment) {
   std::string text;
-  if (!header_comment.empty()) text += "# " + header_comment + "\n";
+  if (!header_comment.empty()) {
+    text += "# " + header_comment + "\n";
+  }
   text += "# timestamp tx ty tz qx qy qz qw\n";
-  for (const auto& p : trajectory) text += FormatTumLine(p.utime, p.pose) + "\n";
+  for (const auto& p : trajectory) {
+    text += FormatTumLine(p.utime, p.pose) + "\n";
+  }
   return WriteStringAtomically(path, text);
 }
 
@@ -182,7 +206,9 @@ Status ReadTartanAirPoses(const std::string& path, int64_t frame_period_us,
   while (std::getline(in, line)) {
     ++line_no;
     const auto tokens = Tokens(line);
-    if (tokens.empty()) continue;
+    if (tokens.empty()) {
+      continue;
+    }
     if (tokens.size() != 7) {
       return Status::Error(path + ":" + std::to_string(line_no) +
                            ": expected 7 values (tx ty tz qx qy qz qw)");
@@ -204,15 +230,21 @@ Status ReadTartanAirPoses(const std::string& path, int64_t frame_period_us,
 std::vector<AssociatedPair> AssociateByTime(const Trajectory& est, const Trajectory& gt,
                                             int64_t max_dt_us) {
   std::vector<AssociatedPair> candidates;
-  if (gt.empty()) return candidates;
+  if (gt.empty()) {
+    return candidates;
+  }
   for (size_t i = 0; i < est.size(); ++i) {
     const int64_t t = est[i].utime;
     auto it = std::lower_bound(gt.begin(), gt.end(), t,
                                [](const TimedPose& p, int64_t time) { return p.utime < time; });
     // Nearest neighbours on both sides.
     for (int side = 0; side < 2; ++side) {
-      if (side == 0 && it == gt.end()) continue;
-      if (side == 1 && it == gt.begin()) continue;
+      if (side == 0 && it == gt.end()) {
+        continue;
+      }
+      if (side == 1 && it == gt.begin()) {
+        continue;
+      }
       const auto jt = side == 0 ? it : std::prev(it);
       const int64_t dt = t - jt->utime;
       if (std::llabs(dt) <= max_dt_us) {
@@ -227,7 +259,9 @@ std::vector<AssociatedPair> AssociateByTime(const Trajectory& est, const Traject
   std::vector<bool> est_used(est.size(), false), gt_used(gt.size(), false);
   std::vector<AssociatedPair> pairs;
   for (const auto& c : candidates) {
-    if (est_used[c.est] || gt_used[c.gt]) continue;
+    if (est_used[c.est] || gt_used[c.gt]) {
+      continue;
+    }
     est_used[c.est] = gt_used[c.gt] = true;
     pairs.push_back(c);
   }

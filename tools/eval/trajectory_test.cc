@@ -70,9 +70,13 @@ TEST(Tum, ParseWriteRoundTrip) {
 
 TEST(Association, NearestOneToOneWithinTolerance) {
   Trajectory gt, est;
-  for (int i = 0; i < 10; ++i) gt.push_back({i * 100000, Rigid3d()});
+  for (int i = 0; i < 10; ++i) {
+    gt.push_back({i * 100000, Rigid3d()});
+  }
   // Estimates 3 ms late, one missing, one far off, two competing for the same truth.
-  for (int i : {0, 1, 2, 4, 5, 6, 7, 8}) est.push_back({i * 100000 + 3000, Rigid3d()});
+  for (int i : {0, 1, 2, 4, 5, 6, 7, 8}) {
+    est.push_back({i * 100000 + 3000, Rigid3d()});
+  }
   est.push_back({950000, Rigid3d()});  // 50 ms from 900000 and 1000000: too far
   SortByTime(&est);
   auto pairs = AssociateByTime(est, gt, 20000);

@@ -23,8 +23,9 @@ struct FrameContext {
 
   FrameContext(const Simulator& s, const SimFrame& f)
       : sim(s), frame(f), K(s.intrinsics()), caster(s.scene()) {
-    for (const auto& b : s.scene().bodies)
+    for (const auto& b : s.scene().bodies) {
       world_from_body.push_back(s.WorldFromBody(b.id, f.utime));
+    }
     cam_from_world = f.world_from_cam.Inverse();
   }
 
@@ -107,7 +108,9 @@ std::string GtCheckReport::ToJson() const {
 
 Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
                              const GtCheckOptions& options, GtCheckReport* report) {
-  if (!options.Check()) return Status::Error("gt check options: " + LastOptionError());
+  if (!options.Check()) {
+    return Status::Error("gt check options: " + LastOptionError());
+  }
   if (frame.mask.empty() || frame.points_in_cam.empty() || frame.depth.empty()) {
     return Status::Error("gt check: the frame was rendered without geometry");
   }
@@ -122,15 +125,21 @@ Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
   for (size_t b = 0; b < bodies.size(); ++b) {
     const int id = bodies[b].id;
     const auto& points = sim.SurfacePoints(id);
-    if (points.empty()) continue;
+    if (points.empty()) {
+      continue;
+    }
     const size_t step =
         std::max<size_t>(1, points.size() / static_cast<size_t>(options.max_samples_per_body));
     const Rigid3d cam_from_body = ctx.cam_from_world * ctx.world_from_body[b];
     for (size_t i = 0; i < points.size(); i += step) {
       const Eigen::Vector3d X = cam_from_body * points[i];
-      if (X.z() < 0.2) continue;
+      if (X.z() < 0.2) {
+        continue;
+      }
       const Eigen::Vector2d uv = K.Project(X);
-      if (!K.InImage(uv, options.border_px)) continue;
+      if (!K.InImage(uv, options.border_px)) {
+        continue;
+      }
       // Visible iff the ray through the projection hits this body at this distance.
       const RayHit hit = ctx.Cast(uv.x(), uv.y());
       if (hit.body_index != static_cast<int>(b) ||
@@ -149,9 +158,13 @@ Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
                        ctx.IdAt(cx + dx, cy + dy) == id;
         }
       }
-      if (!resolvable) continue;
+      if (!resolvable) {
+        continue;
+      }
       ++r.samples_visible;
-      if (id > 0) ++r.samples_visible_moving;
+      if (id > 0) {
+        ++r.samples_visible_moving;
+      }
       double label_error = 2.0;
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
@@ -168,8 +181,9 @@ Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
             << X.z() << " mask/ray:";
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dx = -1; dx <= 1; ++dx) {
-            if (ctx.Inside(cx + dx, cy + dy))
+            if (ctx.Inside(cx + dx, cy + dy)) {
               msg << " " << ctx.MaskAt(cx + dx, cy + dy) << "/" << ctx.IdAt(cx + dx, cy + dy);
+            }
           }
         }
         MBSLAM_LOG(DEBUG) << msg.str();
@@ -177,7 +191,9 @@ Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
 
       // Where did the renderer draw this point? Fit P(x, y) = A [x y 1]^T to the rendered
       // points of the 3x3 neighbourhood; skip neighbourhoods that are not one plane.
-      if (cx < 1 || cy < 1 || cx >= K.width - 1 || cy >= K.height - 1) continue;
+      if (cx < 1 || cy < 1 || cx >= K.width - 1 || cy >= K.height - 1) {
+        continue;
+      }
       Eigen::Matrix<double, 9, 3> design;
       Eigen::Matrix<double, 9, 3> rendered;
       bool uniform = true;
@@ -190,11 +206,15 @@ Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
           rendered.row(row) << p[0], p[1], p[2];
         }
       }
-      if (!uniform) continue;
+      if (!uniform) {
+        continue;
+      }
       const Eigen::Matrix3d A =
           design.colPivHouseholderQr().solve(rendered).transpose();  // 3x3: P = A [x y 1]
       const double fit_rms = std::sqrt((design * A.transpose() - rendered).squaredNorm() / 9.0);
-      if (fit_rms > 2e-5 * X.z() + 1e-6) continue;  // two faces meet here
+      if (fit_rms > 2e-5 * X.z() + 1e-6) {
+        continue;  // two faces meet here
+      }
       // Pixel (x, y) where the fitted surface comes closest to X.
       const Eigen::Matrix<double, 3, 2> J = A.leftCols<2>();
       const Eigen::Vector2d xy = (J.transpose() * J).ldlt().solve(J.transpose() * (X - A.col(2)));
@@ -243,7 +263,9 @@ Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
         }
         if (rendered_id != expected_id) {
           ++r.pixel_label_mismatches;
-          if (on_edge) ++r.pixel_label_mismatches_on_edges;
+          if (on_edge) {
+            ++r.pixel_label_mismatches_on_edges;
+          }
           continue;
         }
         if (on_edge) {
@@ -254,7 +276,9 @@ Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
                           << " rendered " << rendered_depth << " m, ray cast " << expected_depth
                           << " m";
       }
-      if (expected_depth <= 0.0) continue;
+      if (expected_depth <= 0.0) {
+        continue;
+      }
       const double abs_err = std::abs(rendered_depth - expected_depth);
       if (abs_err > 1e-5 * expected_depth) {
         // How far in the image is this depth error? Surfaces seen at grazing angles
@@ -265,12 +289,16 @@ Status CheckFrameGroundTruth(const Simulator& sim, const SimFrame& frame,
         const double steps[2][2] = {{h, 0.0}, {0.0, h}};
         for (const auto& st : steps) {
           const RayHit a = ctx.Cast(x + st[0], y + st[1]), b = ctx.Cast(x - st[0], y - st[1]);
-          if (a.body_index < 0 || b.body_index < 0) continue;
+          if (a.body_index < 0 || b.body_index < 0) {
+            continue;
+          }
           const double za = a.distance * ctx.RayInCam(x + st[0], y + st[1]).z();
           const double zb = b.distance * ctx.RayInCam(x - st[0], y - st[1]).z();
           per_px = std::max(per_px, std::abs(za - zb) / (2.0 * h));
         }
-        if (per_px > 0.0) r.depth_max_error_px = std::max(r.depth_max_error_px, abs_err / per_px);
+        if (per_px > 0.0) {
+          r.depth_max_error_px = std::max(r.depth_max_error_px, abs_err / per_px);
+        }
         if (per_px > 0.01 * expected_depth) {
           ++r.pixel_depth_grazing;
           continue;

@@ -31,14 +31,22 @@ PoseTrack PoseTrack::Constant(const Rigid3d& world_from_body) {
 }
 
 Rigid3d PoseTrack::WorldFromBody(int64_t utime) const {
-  if (samples_.empty()) return Rigid3d();
-  if (samples_.size() == 1 || utime <= begin_utime_) return samples_.front();
+  if (samples_.empty()) {
+    return Rigid3d();
+  }
+  if (samples_.size() == 1 || utime <= begin_utime_) {
+    return samples_.front();
+  }
   const int64_t offset = utime - begin_utime_;
   const int64_t index = offset / step_us_;
-  if (index >= static_cast<int64_t>(samples_.size()) - 1) return samples_.back();
+  if (index >= static_cast<int64_t>(samples_.size()) - 1) {
+    return samples_.back();
+  }
   const int64_t rem = offset - index * step_us_;
   const Rigid3d& a = samples_[static_cast<size_t>(index)];
-  if (rem == 0) return a;
+  if (rem == 0) {
+    return a;
+  }
   const Rigid3d& b = samples_[static_cast<size_t>(index + 1)];
   return Rigid3d::Interpolate(a, b, static_cast<double>(rem) / static_cast<double>(step_us_));
 }
@@ -46,7 +54,9 @@ Rigid3d PoseTrack::WorldFromBody(int64_t utime) const {
 MotionState PoseTrack::StateAt(int64_t utime) const {
   MotionState state;
   state.world_from_body = WorldFromBody(utime);
-  if (samples_.size() < 2) return state;
+  if (samples_.size() < 2) {
+    return state;
+  }
   const Rigid3d before = WorldFromBody(utime - step_us_);
   const Rigid3d after = WorldFromBody(utime + step_us_);
   const double dt = 2e-6 * static_cast<double>(step_us_);
@@ -96,14 +106,18 @@ PlanarPath& PlanarPath::Drive(double duration_s, double acceleration, double yaw
 }
 
 PlanarPath& PlanarPath::RampTo(double speed, double duration_s, double yaw_rate) {
-  if (duration_s <= 0.0) return *this;
+  if (duration_s <= 0.0) {
+    return *this;
+  }
   const double a = (std::max(0.0, speed) - knots_.back().speed) / duration_s;
   Advance(duration_s, a, yaw_rate, false);
   return *this;
 }
 
 PlanarPath& PlanarPath::Turn(double angle_rad, double yaw_rate_abs) {
-  if (yaw_rate_abs <= 0.0 || angle_rad == 0.0) return *this;
+  if (yaw_rate_abs <= 0.0 || angle_rad == 0.0) {
+    return *this;
+  }
   const double rate = angle_rad > 0.0 ? yaw_rate_abs : -yaw_rate_abs;
   Advance(std::abs(angle_rad) / yaw_rate_abs, 0.0, rate, false);
   return *this;
@@ -190,7 +204,9 @@ SmoothNoise3::SmoothNoise3(uint64_t seed, double rms, double f_min_hz, double f_
       axis.push_back(t);
     }
     const double scale = sum_sq > 0.0 ? rms / std::sqrt(sum_sq) : 0.0;
-    for (Term& t : axis) t.amplitude *= scale;
+    for (Term& t : axis) {
+      t.amplitude *= scale;
+    }
   }
 }
 

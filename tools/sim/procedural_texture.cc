@@ -30,7 +30,9 @@ class Rng {
 
 cv::Scalar Clamp01(const cv::Scalar& c) {
   cv::Scalar out;
-  for (int i = 0; i < 3; ++i) out[i] = std::clamp(c[i], 0.0, 1.0);
+  for (int i = 0; i < 3; ++i) {
+    out[i] = std::clamp(c[i], 0.0, 1.0);
+  }
   out[3] = 0.0;
   return out;
 }
@@ -39,7 +41,9 @@ cv::Scalar Clamp01(const cv::Scalar& c) {
 cv::Scalar Vary(Rng* rng, const cv::Scalar& base, double lo, double hi, double jitter) {
   const double k = rng->Uniform(lo, hi);
   cv::Scalar c;
-  for (int i = 0; i < 3; ++i) c[i] = base[i] * k + rng->Normal(jitter);
+  for (int i = 0; i < 3; ++i) {
+    c[i] = base[i] * k + rng->Normal(jitter);
+  }
   return Clamp01(c);
 }
 
@@ -83,14 +87,19 @@ void Modulate(cv::Mat* img, const cv::Mat& noise, double amount) {
   factor = cv::max(factor, 0.0);
   cv::Mat channels[3];
   cv::split(*img, channels);
-  for (auto& c : channels) c = c.mul(factor);
+  for (auto& c : channels) {
+    c = c.mul(factor);
+  }
   cv::merge(channels, 3, *img);
 }
 
 std::vector<cv::Point> IrregularPolygon(Rng* rng, cv::Point2d center, double radius) {
   const int n = rng->Int(3, 8);
   std::vector<double> angles;
-  for (int i = 0; i < n; ++i) angles.push_back(rng->Uniform(0.0, 2.0 * M_PI));
+  angles.reserve(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    angles.push_back(rng->Uniform(0.0, 2.0 * M_PI));
+  }
   std::sort(angles.begin(), angles.end());
   std::vector<cv::Point> pts;
   for (double a : angles) {
@@ -104,7 +113,9 @@ std::vector<cv::Point> IrregularPolygon(Rng* rng, cv::Point2d center, double rad
 // [min_px, max_px]; colours from `color`.
 template <typename ColorFn>
 void DrawBlobs(cv::Mat* img, Rng* rng, int count, double min_px, double max_px, ColorFn color) {
-  if (max_px < min_px) max_px = min_px;
+  if (max_px < min_px) {
+    max_px = min_px;
+  }
   for (int i = 0; i < count; ++i) {
     const cv::Point2d c(rng->Uniform(-max_px, img->cols + max_px),
                         rng->Uniform(-max_px, img->rows + max_px));
@@ -127,7 +138,9 @@ void DrawBlobs(cv::Mat* img, Rng* rng, int count, double min_px, double max_px, 
       cv::Point2f corners[4];
       rect.points(corners);
       std::vector<cv::Point> pts;
-      for (const auto& p : corners) pts.emplace_back(cvRound(p.x), cvRound(p.y));
+      for (const auto& p : corners) {
+        pts.emplace_back(cvRound(p.x), cvRound(p.y));
+      }
       cv::fillConvexPoly(*img, pts, col);
     }
   }
@@ -177,7 +190,10 @@ void DrawVoronoiStones(cv::Mat* img, Rng* rng, double stone_px, const cv::Scalar
   const int joint = std::max(1, cvRound(joint_px));
   for (const auto& f : facets) {
     std::vector<cv::Point> poly;
-    for (const auto& p : f) poly.emplace_back(cvRound(p.x), cvRound(p.y));
+    poly.reserve(f.size());
+    for (const auto& p : f) {
+      poly.emplace_back(cvRound(p.x), cvRound(p.y));
+    }
     cv::fillConvexPoly(*img, poly, Vary(rng, base, 0.6, 1.35, 0.015));
     cv::polylines(*img, std::vector<std::vector<cv::Point>>{poly}, true,
                   base * rng->Uniform(0.25, 0.45), joint);
@@ -225,7 +241,9 @@ cv::Mat FractalNoise(int width, int height, uint64_t seed, double largest_cell_p
       const int gh = static_cast<int>(std::ceil(height / cell)) + 3;
       cv::Mat grid(gh, gw, CV_32F);
       for (int r = 0; r < gh; ++r) {
-        for (int c = 0; c < gw; ++c) grid.at<float>(r, c) = static_cast<float>(rng.Normal(1.0));
+        for (int c = 0; c < gw; ++c) {
+          grid.at<float>(r, c) = static_cast<float>(rng.Normal(1.0));
+        }
       }
       // Smooth (bicubic) upsampling of the random grid, cropped at a random sub-cell
       // offset so that octaves do not share their cell boundaries.
@@ -363,10 +381,12 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
       img.setTo(base);
       Modulate(&img, low, 0.2);
       // Formwork seams at irregular spacing.
-      for (double x = px(rng.Uniform(0.2, 1.0)); x < width; x += px(rng.Uniform(0.6, 1.6))) {
+      double x = px(rng.Uniform(0.2, 1.0));
+      while (x < width) {
         cv::line(img, cv::Point(cvRound(x), 0),
                  cv::Point(cvRound(x + rng.Normal(px(0.05))), height),
                  Vary(&rng, base, 0.55, 0.75, 0.02), std::max(1, cvRound(px(0.01))));
+        x += px(rng.Uniform(0.6, 1.6));
       }
       DrawBlobs(&img, &rng, CountFor(img, 30), px(0.05), px(0.6),
                 [&](Rng* r) { return Vary(r, base, 0.6, 1.25, 0.04); });
@@ -408,11 +428,13 @@ cv::Mat MakeTexture(TextureStyle style, int width, int height, double texel_m, u
       const double stripe = px(rng.Uniform(0.02, 0.08));
       const double angle = rng.Uniform(0.0, M_PI);
       const cv::Point2d dir(std::cos(angle), std::sin(angle));
-      for (double s = -max_dim; s < 2 * max_dim; s += stripe * rng.Uniform(2.0, 6.0)) {
+      double s = -max_dim;
+      while (s < 2 * max_dim) {
         const cv::Point2d n(-dir.y, dir.x);
         const cv::Point2d c = n * s;
         cv::line(img, c - dir * 2.0 * max_dim, c + dir * 2.0 * max_dim,
                  Vary(&rng, second, 0.7, 1.2, 0.05), std::max(1, cvRound(stripe)));
+        s += stripe * rng.Uniform(2.0, 6.0);
       }
       DrawBlobs(&img, &rng, CountFor(img, 300), px(0.02), px(0.15), [&](Rng* r) {
         return r->Chance(0.5) ? RandomSaturated(r) : Vary(r, base, 0.3, 1.6, 0.05);

@@ -143,10 +143,13 @@ struct Renderer::Impl {
   std::vector<float> read_buffer;
 
   ~Impl() {
-    if (!context) return;
+    if (!context) {
+      return;
+    }
     if (MakeCurrent()) {
-      if (!textures.empty())
+      if (!textures.empty()) {
         glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+      }
       glDeleteTextures(1, &detail_texture);
       GLuint rbs[] = {color_rb, color_depth_rb, resolve_rb, geometry_rb, geometry_depth_rb};
       glDeleteRenderbuffers(5, rbs);
@@ -180,9 +183,13 @@ struct Renderer::Impl {
                            5,
                            0};
     context = OSMesaCreateContextAttribs(attribs, nullptr);
-    if (!context) return Status::Error("OSMesa: cannot create a GL 4.5 core context");
-    default_buffer.assign(4 * 4 * 4, 0);
-    if (!MakeCurrent()) return Status::Error("OSMesa: cannot make the context current");
+    if (!context) {
+      return Status::Error("OSMesa: cannot create a GL 4.5 core context");
+    }
+    default_buffer.assign(size_t{4} * 4 * 4, 0);
+    if (!MakeCurrent()) {
+      return Status::Error("OSMesa: cannot make the context current");
+    }
 
     MBSLAM_RETURN_IF_ERROR(BuildProgram(kColorFragmentShader, &color_program));
     MBSLAM_RETURN_IF_ERROR(BuildProgram(kGeometryFragmentShader, &geometry_program));
@@ -202,10 +209,14 @@ struct Renderer::Impl {
     using ClipControlFn = void (*)(GLenum, GLenum);
     const auto clip_control =
         reinterpret_cast<ClipControlFn>(OSMesaGetProcAddress("glClipControl"));
-    if (!clip_control) return Status::Error("OSMesa: glClipControl is not available");
+    if (!clip_control) {
+      return Status::Error("OSMesa: glClipControl is not available");
+    }
     clip_control(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     const GLenum err = glGetError();
-    if (err != GL_NO_ERROR) return Status::Error("GL error during set-up: " + std::to_string(err));
+    if (err != GL_NO_ERROR) {
+      return Status::Error("GL error during set-up: " + std::to_string(err));
+    }
     return Status::Ok();
   }
 
@@ -272,11 +283,14 @@ struct Renderer::Impl {
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)),
                  vertices.data(), GL_STATIC_DRAW);
     const GLsizei stride = 7 * sizeof(float);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(0));
-    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<void*>(3 * sizeof(float)));
-    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<void*>(5 * sizeof(float)));
+    // Offsets into the bound buffer, passed as pointers (the GL API).
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, nullptr);
+    glVertexAttribPointer(
+        1, 2, GL_FLOAT, GL_FALSE, stride,
+        reinterpret_cast<void*>(3 * sizeof(float)));  // NOLINT(performance-no-int-to-ptr)
+    glVertexAttribPointer(
+        2, 2, GL_FLOAT, GL_FALSE, stride,
+        reinterpret_cast<void*>(5 * sizeof(float)));  // NOLINT(performance-no-int-to-ptr)
     glEnableVertexAttribArray(0);
     glEnableVertexAttribArray(1);
     glEnableVertexAttribArray(2);
@@ -302,8 +316,9 @@ struct Renderer::Impl {
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
       glTexParameterf(GL_TEXTURE_2D, kMaxAnisotropy, static_cast<float>(options.anisotropy));
     }
-    for (auto& d : draws)
+    for (auto& d : draws) {
       d.texture = textures[static_cast<size_t>(scene->bodies[d.body].quads[d.quad].texture)];
+    }
     const cv::Mat detail = MakeDetailTexture(1024, 7);
     glGenTextures(1, &detail_texture);
     glBindTexture(GL_TEXTURE_2D, detail_texture);
@@ -416,10 +431,14 @@ struct Renderer::Impl {
         const Eigen::Matrix4f cam_f = cam.cast<float>();
         glUniformMatrix4fv(p.clip_from_body, 1, GL_FALSE, clip_f.data());
         glUniformMatrix4fv(p.cam_from_body, 1, GL_FALSE, cam_f.data());
-        if (geometry) glUniform1f(p.body_id, static_cast<float>(scene->bodies[d.body].id));
+        if (geometry) {
+          glUniform1f(p.body_id, static_cast<float>(scene->bodies[d.body].id));
+        }
       }
       const Quad& q = scene->bodies[d.body].quads[d.quad];
-      if (Culled(clip_from_body, q)) continue;
+      if (Culled(clip_from_body, q)) {
+        continue;
+      }
       if (!geometry) {
         const Eigen::Vector3d n = cam_from_body[d.body].rotation * q.Normal();
         const double shade =
@@ -430,7 +449,9 @@ struct Renderer::Impl {
       glDrawArrays(GL_TRIANGLE_FAN, d.first_vertex, 4);
     }
     const GLenum err = glGetError();
-    if (err != GL_NO_ERROR) return Status::Error("GL error while drawing: " + std::to_string(err));
+    if (err != GL_NO_ERROR) {
+      return Status::Error("GL error while drawing: " + std::to_string(err));
+    }
     return Status::Ok();
   }
 };
@@ -441,7 +462,9 @@ Renderer::~Renderer() = default;
 std::unique_ptr<Renderer> Renderer::Create(const Scene& scene, const CameraIntrinsics& intrinsics,
                                            const RendererOptions& options, Status* status) {
   *status = intrinsics.Validate();
-  if (!status->ok()) return nullptr;
+  if (!status->ok()) {
+    return nullptr;
+  }
   if (intrinsics.HasDistortion()) {
     *status = Status::Error("renderer: distorted cameras are not supported");
     return nullptr;
@@ -459,13 +482,17 @@ std::unique_ptr<Renderer> Renderer::Create(const Scene& scene, const CameraIntri
   impl->intrinsics = intrinsics;
   impl->options = options;
   *status = impl->Init();
-  if (!status->ok()) return nullptr;
+  if (!status->ok()) {
+    return nullptr;
+  }
   return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
 
 Status Renderer::RenderColor(const std::vector<Rigid3d>& cam_from_body, cv::Mat* bgr) {
   Impl& m = *impl_;
-  if (!m.MakeCurrent()) return Status::Error("OSMesa: cannot make the context current");
+  if (!m.MakeCurrent()) {
+    return Status::Error("OSMesa: cannot make the context current");
+  }
   const int w = m.intrinsics.width, h = m.intrinsics.height;
   glBindFramebuffer(GL_FRAMEBUFFER, m.color_fbo);
   const GLfloat sky[4] = {static_cast<GLfloat>(m.options.sky_bgr[2]),
@@ -484,8 +511,9 @@ Status Renderer::RenderColor(const std::vector<Rigid3d>& cam_from_body, cv::Mat*
   cv::Mat bgra(h, w, CV_8UC4);
   glReadPixels(0, 0, w, h, GL_BGRA, GL_UNSIGNED_BYTE, bgra.data);
   const GLenum err = glGetError();
-  if (err != GL_NO_ERROR)
+  if (err != GL_NO_ERROR) {
     return Status::Error("GL error reading the colour image: " + std::to_string(err));
+  }
   cv::flip(bgra, bgra, 0);
   cv::cvtColor(bgra, *bgr, cv::COLOR_BGRA2BGR);
   return Status::Ok();
@@ -494,7 +522,9 @@ Status Renderer::RenderColor(const std::vector<Rigid3d>& cam_from_body, cv::Mat*
 Status Renderer::RenderGeometry(const std::vector<Rigid3d>& cam_from_body, cv::Mat* body_id,
                                 cv::Mat* points_in_cam) {
   Impl& m = *impl_;
-  if (!m.MakeCurrent()) return Status::Error("OSMesa: cannot make the context current");
+  if (!m.MakeCurrent()) {
+    return Status::Error("OSMesa: cannot make the context current");
+  }
   const int w = m.intrinsics.width, h = m.intrinsics.height;
   glBindFramebuffer(GL_FRAMEBUFFER, m.geometry_fbo);
   const GLfloat clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
@@ -508,8 +538,9 @@ Status Renderer::RenderGeometry(const std::vector<Rigid3d>& cam_from_body, cv::M
   cv::Mat geom(h, w, CV_32FC4);
   glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, geom.data);
   const GLenum err = glGetError();
-  if (err != GL_NO_ERROR)
+  if (err != GL_NO_ERROR) {
     return Status::Error("GL error reading the geometry: " + std::to_string(err));
+  }
   body_id->create(h, w, CV_16UC1);
   points_in_cam->create(h, w, CV_32FC3);
   for (int r = 0; r < h; ++r) {

@@ -50,7 +50,9 @@ Simulator* Get(const std::string& scenario, int width = 320) {
 Eigen::Vector2d Project(const Simulator& sim, const Rigid3d& cam_from_world,
                         const Eigen::Vector3d& p_world, double* depth = nullptr) {
   const Eigen::Vector3d p = cam_from_world * p_world;
-  if (depth) *depth = p.z();
+  if (depth) {
+    *depth = p.z();
+  }
   return sim.intrinsics().Project(p);
 }
 
@@ -66,7 +68,9 @@ TEST(Scenarios, AllRegistered) {
 // The build generates a fixture for every scenario (tools/sim/CMakeLists.txt).
 TEST(Scenarios, EveryScenarioHasABuildFixture) {
   const char* bin = std::getenv("MBSLAM_BIN_DIR");
-  if (!bin) GTEST_SKIP() << "MBSLAM_BIN_DIR not set (run through ctest)";
+  if (!bin) {
+    GTEST_SKIP() << "MBSLAM_BIN_DIR not set (run through ctest)";
+  }
   const std::string fixtures = std::string(bin) + "/../fixtures/sim/";
   for (const auto& name : ScenarioNames()) {
     EXPECT_TRUE(std::ifstream(fixtures + name + "/timestamps.txt").good())
@@ -87,12 +91,16 @@ TEST(Scenarios, MultiCoversAQuarterOfTheImage) {
   for (int k = 0; k < sim->num_frames(); ++k) {
     ASSERT_TRUE(sim->RenderFrame(k, &f, RenderRequest{false, true}).ok());
     sum += f.MovingFraction();
-    for (size_t i = 0; i < f.bodies.size(); ++i) visible[i] += f.bodies[i].visible ? 1 : 0;
+    for (size_t i = 0; i < f.bodies.size(); ++i) {
+      visible[i] += f.bodies[i].visible ? 1 : 0;
+    }
   }
   const double mean = sum / sim->num_frames();
   RecordProperty("multi_mean_moving_fraction", std::to_string(mean));
   EXPECT_GE(mean, 0.25);
-  for (int v : visible) EXPECT_GT(v, sim->num_frames() / 2);
+  for (int v : visible) {
+    EXPECT_GT(v, sim->num_frames() / 2);
+  }
 }
 
 // Outside multi, movers never fill the frame and nothing sits right in front of the lens.
@@ -126,7 +134,9 @@ TEST(Scenarios, CrossingEntersLeavesAndOccludes) {
   SimFrame f;
   for (int k = 0; k < sim->num_frames(); k += 3) {
     ASSERT_TRUE(sim->RenderFrame(k, &f, RenderRequest{false, true}).ok());
-    for (size_t i = 0; i < ids.size(); ++i) visible[i].push_back(f.bodies[i].visible);
+    for (size_t i = 0; i < ids.size(); ++i) {
+      visible[i].push_back(f.bodies[i].visible);
+    }
     // A mover occluded by another: its surface samples project onto pixels of a
     // different mover that is closer.
     const Rigid3d cam_from_world = f.world_from_cam.Inverse();
@@ -136,7 +146,9 @@ TEST(Scenarios, CrossingEntersLeavesAndOccludes) {
       for (const auto& p : sim->SurfacePoints(ids[i])) {
         double z;
         const Eigen::Vector2d uv = Project(*sim, cam_from_world, world_from_body * p, &z);
-        if (z <= 0.1 || !sim->intrinsics().InImage(uv, 1.0)) continue;
+        if (z <= 0.1 || !sim->intrinsics().InImage(uv, 1.0)) {
+          continue;
+        }
         const int x = static_cast<int>(std::lround(uv.x())),
                   y = static_cast<int>(std::lround(uv.y()));
         const int other = f.mask.at<uint16_t>(y, x);
@@ -152,10 +164,13 @@ TEST(Scenarios, CrossingEntersLeavesAndOccludes) {
   int enter_and_leave = 0;
   for (const auto& v : visible) {
     const auto first = std::find(v.begin(), v.end(), true);
-    if (first == v.end() || first == v.begin())
+    if (first == v.end() || first == v.begin()) {
       continue;  // never visible or visible from the start
+    }
     const auto after = std::find(first, v.end(), false);
-    if (after != v.end()) ++enter_and_leave;
+    if (after != v.end()) {
+      ++enter_and_leave;
+    }
   }
   EXPECT_GE(enter_and_leave, 1);
 }
@@ -193,8 +208,9 @@ EpipolarStats BodyEpipolar(const Simulator& sim, int id, int ka, int kb) {
   for (const auto& p : sim.SurfacePoints(id)) {
     double za, zb;
     const Eigen::Vector2d a = Project(sim, ca, wa * p, &za), b = Project(sim, cb, wb * p, &zb);
-    if (za < 0.5 || zb < 0.5 || !sim.intrinsics().InImage(a) || !sim.intrinsics().InImage(b))
+    if (za < 0.5 || zb < 0.5 || !sim.intrinsics().InImage(a) || !sim.intrinsics().InImage(b)) {
       continue;
+    }
     ++s.points;
     s.max_distance = std::max(s.max_distance, EpipolarDistance(F, a, b));
     motion.push_back((b - a).norm());
@@ -216,7 +232,9 @@ TEST(Scenarios, FollowingIsDegenerate) {
   for (int id : sim->MovingBodyIds()) {
     for (int k = 0; k + 60 < sim->num_frames(); k += 45) {
       const EpipolarStats s = BodyEpipolar(*sim, id, k, k + 60);
-      if (s.points < 20) continue;
+      if (s.points < 20) {
+        continue;
+      }
       ++checked;
       EXPECT_LT(s.max_distance, 0.01) << "body " << id << " frame " << k;
       EXPECT_GT(s.median_motion, 0.25) << "body " << id << " frame " << k;
@@ -253,7 +271,9 @@ TEST(Scenarios, PreviouslyStaticObjectsStartMoving) {
       ASSERT_TRUE(sim->RenderFrame(k, &f, RenderRequest{false, true}).ok());
       const SimBodyState& b = f.bodies[static_cast<size_t>(id - 1)];
       const double speed = b.linear_velocity.norm();
-      if (!started && speed > 1e-6) started = true;
+      if (!started && speed > 1e-6) {
+        started = true;
+      }
       if (!started) {
         EXPECT_LT(speed, 1e-9);
         still_visible += b.visible;
@@ -337,10 +357,14 @@ TEST(Scenarios, TexturedAndTrackable) {
     std::vector<cv::KeyPoint> kps;
     cv::FAST(a.image_gray, kps, 15, true);
     std::map<int, int> per_body;
-    for (const auto& kp : kps) ++per_body[a.mask.at<uint16_t>(cvRound(kp.pt.y), cvRound(kp.pt.x))];
+    for (const auto& kp : kps) {
+      ++per_body[a.mask.at<uint16_t>(cvRound(kp.pt.y), cvRound(kp.pt.x))];
+    }
     EXPECT_GT(per_body[0], 300) << name;
     for (const auto& body : a.bodies) {
-      if (body.pixel_count < 2000) continue;
+      if (body.pixel_count < 2000) {
+        continue;
+      }
       EXPECT_GT(per_body[body.id], body.pixel_count / 250)
           << name << " body " << body.id << " (" << body.pixel_count << " px)";
     }
@@ -355,15 +379,20 @@ TEST(Scenarios, TexturedAndTrackable) {
     std::vector<double> errors;
     for (size_t i = 0; i < p0.size(); ++i) {
       const int x = cvRound(p0[i].x), y = cvRound(p0[i].y);
-      if (x < 1 || y < 1 || x >= a.mask.cols - 1 || y >= a.mask.rows - 1) continue;
+      if (x < 1 || y < 1 || x >= a.mask.cols - 1 || y >= a.mask.rows - 1) {
+        continue;
+      }
       const int id = a.mask.at<uint16_t>(y, x);
       // Only interior points of one surface: all 3x3 neighbours on the same body.
       bool interior = a.depth.at<float>(y, x) > 0.0f;
       for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx)
+        for (int dx = -1; dx <= 1; ++dx) {
           interior = interior && a.mask.at<uint16_t>(y + dy, x + dx) == id;
+        }
       }
-      if (!interior) continue;
+      if (!interior) {
+        continue;
+      }
       // The surface point under the feature (bilinear in the rendered points), moved with
       // its body to frame k+1.
       cv::Mat patch;
@@ -374,7 +403,9 @@ TEST(Scenarios, TexturedAndTrackable) {
           sim->WorldFromBody(id, b.utime) * sim->WorldFromBody(id, a.utime).Inverse();
       const Eigen::Vector2d expected =
           sim->intrinsics().Project(cam_b_from_world * (b_from_a_body * in_world));
-      if (!ok[i] || !sim->intrinsics().InImage(expected, 10.0)) continue;
+      if (!ok[i] || !sim->intrinsics().InImage(expected, 10.0)) {
+        continue;
+      }
       errors.push_back((expected - Eigen::Vector2d(p1[i].x, p1[i].y)).norm());
     }
     ASSERT_GT(errors.size(), 100u) << name;

@@ -374,7 +374,9 @@ Corridor CorridorOf(const PoseTrack& track, const Timeline& tl, double half_widt
 bool Intersects(const Eigen::AlignedBox2d& rect, const std::vector<Corridor>& corridors) {
   for (const Corridor& c : corridors) {
     for (const auto& p : c.points) {
-      if (rect.exteriorDistance(p) < c.half_width) return true;
+      if (rect.exteriorDistance(p) < c.half_width) {
+        return true;
+      }
     }
   }
   return false;
@@ -414,9 +416,11 @@ void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder
   const double tile = 10.0;
   const double gx0 = std::floor((area.min().x() - 40.0) / tile) * tile;
   const double gy0 = std::floor((area.min().y() - 40.0) / tile) * tile;
-  const double gx1 = area.max().x() + 40.0, gy1 = area.max().y() + 40.0;
-  for (double x = gx0; x < gx1; x += tile) {
-    for (double y = gy0; y < gy1; y += tile) {
+  const int nx = static_cast<int>(std::ceil((area.max().x() + 40.0 - gx0) / tile));
+  const int ny = static_cast<int>(std::ceil((area.max().y() + 40.0 - gy0) / tile));
+  for (int ix = 0; ix < nx; ++ix) {
+    for (int iy = 0; iy < ny; ++iy) {
+      const double x = gx0 + ix * tile, y = gy0 + iy * tile;
       const double r = rng->Uniform(0.0, 1.0);
       const TextureStyle style = r < 0.45
                                      ? TextureStyle::kAsphalt
@@ -507,12 +511,18 @@ void BuildStaticWorld(const ScenarioPlan& plan, const Timeline& tl, SceneBuilder
     const double r = 0.5 * std::hypot(size.x(), size.y());
     const Eigen::AlignedBox2d bound(c - Eigen::Vector2d::Constant(r),
                                     c + Eigen::Vector2d::Constant(r));
-    if (Intersects(bound, clutter_keep_out)) continue;
+    if (Intersects(bound, clutter_keep_out)) {
+      continue;
+    }
     bool overlaps = false;
     for (const auto& p : placed) {
-      if (p.intersects(bound)) overlaps = true;
+      if (p.intersects(bound)) {
+        overlaps = true;
+      }
     }
-    if (overlaps) continue;
+    if (overlaps) {
+      continue;
+    }
     placed.push_back(bound);
     builder->AddBox(world, identity, Eigen::Vector3d(c.x(), c.y(), 0.5 * size.z()), size, yaw,
                     style, false, tint);
@@ -539,13 +549,17 @@ TextureStyle StyleFor(BodyClass c) {
 
 std::vector<std::string> ScenarioNames() {
   std::vector<std::string> names;
-  for (const auto& e : Registry()) names.emplace_back(e.name);
+  for (const auto& e : Registry()) {
+    names.emplace_back(e.name);
+  }
   return names;
 }
 
 std::string ScenarioDescription(const std::string& name) {
   for (const auto& e : Registry()) {
-    if (name == e.name) return e.description;
+    if (name == e.name) {
+      return e.description;
+    }
   }
   return "";
 }
@@ -553,11 +567,15 @@ std::string ScenarioDescription(const std::string& name) {
 Status BuildScenario(const SimOptions& options, Scene* scene) {
   const ScenarioEntry* entry = nullptr;
   for (const auto& e : Registry()) {
-    if (options.scenario == e.name) entry = &e;
+    if (options.scenario == e.name) {
+      entry = &e;
+    }
   }
   if (!entry) {
     std::string known;
-    for (const auto& n : ScenarioNames()) known += (known.empty() ? "" : ", ") + n;
+    for (const auto& n : ScenarioNames()) {
+      known += (known.empty() ? "" : ", ") + n;
+    }
     return Status::Error("unknown scenario '" + options.scenario + "' (known: " + known + ")");
   }
   Timeline tl;
@@ -608,7 +626,9 @@ Status BuildScenario(const SimOptions& options, Scene* scene) {
   builder.GenerateTextures(
       static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 4u)));
   size_t texture_bytes = 0;
-  for (const auto& t : scene->textures) texture_bytes += t.total() * t.elemSize();
+  for (const auto& t : scene->textures) {
+    texture_bytes += t.total() * t.elemSize();
+  }
   MBSLAM_LOG(DEBUG) << "scenario " << scene->scenario << ": " << scene->bodies.size() << " bodies, "
                     << scene->bodies[0].quads.size() << " static quads, " << scene->textures.size()
                     << " textures (" << texture_bytes / (1 << 20) << " MiB)";

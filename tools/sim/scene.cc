@@ -28,7 +28,9 @@ const char* BodyClassName(BodyClass c) {
 
 int Scene::BodyIndex(int id) const {
   for (size_t i = 0; i < bodies.size(); ++i) {
-    if (bodies[i].id == id) return static_cast<int>(i);
+    if (bodies[i].id == id) {
+      return static_cast<int>(i);
+    }
   }
   return -1;
 }
@@ -61,7 +63,9 @@ uint64_t SceneBuilder::NextSeed() {
 
 double SceneBuilder::DistanceToCamera(const Eigen::Vector3d& point) const {
   double best = std::numeric_limits<double>::infinity();
-  for (const auto& c : camera_positions_) best = std::min(best, (c - point).norm());
+  for (const auto& c : camera_positions_) {
+    best = std::min(best, (c - point).norm());
+  }
   return best;
 }
 
@@ -78,7 +82,9 @@ int SceneBuilder::AddTexture(const Quad& quad, const Rigid3d& world_from_body, b
       for (double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
         const Eigen::Vector3d p = world_from_body * quad.Point(s, t);
         distance = std::min(distance, DistanceToCamera(p));
-        for (const auto& c : camera_positions_) front_seen = front_seen || n.dot(c - p) > 0.0;
+        for (const auto& c : camera_positions_) {
+          front_seen = front_seen || n.dot(c - p) > 0.0;
+        }
       }
     }
     if (!front_seen) {  // a token texture: it is never drawn into any image
@@ -116,9 +122,13 @@ void SceneBuilder::GenerateTextures(int threads) {
     }
   };
   std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
+  for (int t = 1; t < std::max(1, threads); ++t) {
+    pool.emplace_back(work);
+  }
   work();
-  for (auto& t : pool) t.join();
+  for (auto& t : pool) {
+    t.join();
+  }
   jobs_.clear();
 }
 
@@ -140,7 +150,9 @@ void SceneBuilder::AddBox(SceneBody* body, const Rigid3d& world_from_body,
       {{-a, -b, -c}, {2 * a, 0, 0}, {0, 0, 2 * c}},  // -y
       {{-a, -b, c}, {2 * a, 0, 0}, {0, 2 * b, 0}},   // +z
   };
-  if (with_bottom) faces.push_back({{-a, b, -c}, {2 * a, 0, 0}, {0, -2 * b, 0}});  // -z
+  if (with_bottom) {
+    faces.push_back({{-a, b, -c}, {2 * a, 0, 0}, {0, -2 * b, 0}});  // -z
+  }
   for (const Face& f : faces) {
     Quad q;
     q.origin = center_in_body + R * f.o;
@@ -170,9 +182,13 @@ bool IntersectQuad(const Quad& q, const Eigen::Vector3d& o, const Eigen::Vector3
                    double* s_out, double* t_out) {
   const Eigen::Vector3d n = q.edge_u.cross(q.edge_v);
   const double denom = n.dot(d);
-  if (denom >= 0.0) return false;  // parallel or seen from behind
+  if (denom >= 0.0) {
+    return false;  // parallel or seen from behind
+  }
   const double dist = n.dot(q.origin - o) / denom;
-  if (dist <= 0.0) return false;
+  if (dist <= 0.0) {
+    return false;
+  }
   const Eigen::Vector3d p = o + dist * d - q.origin;
   // Solve p = s u + t v in the least-squares sense (exact for points in the plane).
   const double uu = q.edge_u.dot(q.edge_u), uv = q.edge_u.dot(q.edge_v),
@@ -181,7 +197,9 @@ bool IntersectQuad(const Quad& q, const Eigen::Vector3d& o, const Eigen::Vector3
   const double det = uu * vv - uv * uv;
   const double s = (pu * vv - pv * uv) / det;
   const double tt = (pv * uu - pu * uv) / det;
-  if (s < 0.0 || s > 1.0 || tt < 0.0 || tt > 1.0) return false;
+  if (s < 0.0 || s > 1.0 || tt < 0.0 || tt > 1.0) {
+    return false;
+  }
   *t = dist;
   *s_out = s;
   *t_out = tt;
@@ -194,14 +212,20 @@ bool RayHitsBox(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& o,
   for (int i = 0; i < 3; ++i) {
     const double lo = box.min()[i] - 1e-9, hi = box.max()[i] + 1e-9;
     if (std::abs(d[i]) < 1e-15) {
-      if (o[i] < lo || o[i] > hi) return false;
+      if (o[i] < lo || o[i] > hi) {
+        return false;
+      }
       continue;
     }
     double a = (lo - o[i]) / d[i], b = (hi - o[i]) / d[i];
-    if (a > b) std::swap(a, b);
+    if (a > b) {
+      std::swap(a, b);
+    }
     t0 = std::max(t0, a);
     t1 = std::min(t1, b);
-    if (t0 > t1) return false;
+    if (t0 > t1) {
+      return false;
+    }
   }
   return true;
 }
@@ -209,7 +233,9 @@ bool RayHitsBox(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& o,
 }  // namespace
 
 RayCaster::RayCaster(const Scene& scene) : scene_(scene) {
-  for (size_t b = 0; b < scene.bodies.size(); ++b) bounds_.push_back(scene.BodyBounds(b));
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    bounds_.push_back(scene.BodyBounds(b));
+  }
 }
 
 RayHit RayCaster::Cast(const std::vector<Rigid3d>& world_from_body, const Eigen::Vector3d& origin,
@@ -221,11 +247,15 @@ RayHit RayCaster::Cast(const std::vector<Rigid3d>& world_from_body, const Eigen:
     const Rigid3d body_from_world = world_from_body[b].Inverse();
     const Eigen::Vector3d o = body_from_world * origin;
     const Eigen::Vector3d d = body_from_world.rotation * direction;
-    if (!RayHitsBox(bounds_[b], o, d)) continue;
+    if (!RayHitsBox(bounds_[b], o, d)) {
+      continue;
+    }
     const auto& quads = scene.bodies[b].quads;
     for (size_t k = 0; k < quads.size(); ++k) {
       double t, s, tt;
-      if (!IntersectQuad(quads[k], o, d, &t, &s, &tt) || t >= best.distance) continue;
+      if (!IntersectQuad(quads[k], o, d, &t, &s, &tt) || t >= best.distance) {
+        continue;
+      }
       best.body_index = static_cast<int>(b);
       best.quad_index = static_cast<int>(k);
       best.distance = t;
@@ -234,7 +264,9 @@ RayHit RayCaster::Cast(const std::vector<Rigid3d>& world_from_body, const Eigen:
       best.edge_distance = std::min({s * lu, (1.0 - s) * lu, tt * lv, (1.0 - tt) * lv});
     }
   }
-  if (best.body_index < 0) best.distance = 0.0;
+  if (best.body_index < 0) {
+    best.distance = 0.0;
+  }
   return best;
 }
 
@@ -247,7 +279,9 @@ std::vector<Eigen::Vector3d> SampleSurfacePoints(const SceneBody& body, double p
     cumulative.push_back(total);
   }
   std::vector<Eigen::Vector3d> points;
-  if (body.quads.empty() || total <= 0.0) return points;
+  if (body.quads.empty() || total <= 0.0) {
+    return points;
+  }
   const int n =
       std::clamp(static_cast<int>(std::lround(points_per_m2 * total)), min_points, max_points);
   std::mt19937_64 rng(seed);

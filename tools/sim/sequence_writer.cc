@@ -35,7 +35,9 @@ std::string FrameName(int k, const char* ext) {
 }
 
 void CopyPose(const Rigid3d& pose, double position[3], double orientation[4]) {
-  for (int i = 0; i < 3; ++i) position[i] = pose.translation[i];
+  for (int i = 0; i < 3; ++i) {
+    position[i] = pose.translation[i];
+  }
   orientation[0] = pose.rotation.w();
   orientation[1] = pose.rotation.x();
   orientation[2] = pose.rotation.y();
@@ -43,12 +45,16 @@ void CopyPose(const Rigid3d& pose, double position[3], double orientation[4]) {
 }
 
 void CopyVector(const Eigen::Vector3d& v, double out[3]) {
-  for (int i = 0; i < 3; ++i) out[i] = v[i];
+  for (int i = 0; i < 3; ++i) {
+    out[i] = v[i];
+  }
 }
 
 void CopyMatrix(const Matrix6d& m, double out[36]) {
   for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 6; ++c) out[r * 6 + c] = m(r, c);  // row-major
+    for (int c = 0; c < 6; ++c) {
+      out[r * 6 + c] = m(r, c);  // row-major
+    }
   }
 }
 
@@ -72,7 +78,9 @@ Status MakeImageMessage(const SimFrame& frame, const Simulator& sim, const Seque
   } else {
     const bool png = o.lcm_image_encoding == "png";
     std::vector<int> params;
-    if (!png) params = {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality};
+    if (!png) {
+      params = {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality};
+    }
     std::vector<uint8_t> bytes;
     if (!cv::imencode(png ? ".png" : ".jpg", o.color_images ? bgr : gray, bytes, params)) {
       return Status::Error("encoding image " + std::to_string(frame.index) + " failed");
@@ -139,7 +147,9 @@ mbslam::odometry_t MakeOdometryMessage(const OdometrySample& o) {
 Status WriteImage(const std::string& path, const cv::Mat& img,
                   const std::vector<int>& params = {}) {
   try {
-    if (!cv::imwrite(path, img, params)) return Status::Error("cannot write " + path);
+    if (!cv::imwrite(path, img, params)) {
+      return Status::Error("cannot write " + path);
+    }
   } catch (const cv::Exception& e) {
     return Status::Error("cannot write " + path + ": " + e.what());
   }
@@ -160,7 +170,9 @@ Status WriteFrameFiles(const fs::path& root, const SequenceWriterOptions& option
   if (options.write_masks) {
     MBSLAM_RETURN_IF_ERROR(WriteImage((root / "masks" / FrameName(k, "png")).string(), mask));
   }
-  if (!options.write_depth) return Status::Ok();
+  if (!options.write_depth) {
+    return Status::Ok();
+  }
   if (options.depth_format == "exr") {
     const int compression = options.exr_compression == "none"  ? cv::IMWRITE_EXR_COMPRESSION_NO
                             : options.exr_compression == "zip" ? cv::IMWRITE_EXR_COMPRESSION_ZIP
@@ -198,7 +210,9 @@ class FileWriterThread {
   // Waits for every queued frame; the first error, if any.
   Status Finish() {
     queue_.Shutdown();
-    if (thread_.joinable()) thread_.join();
+    if (thread_.joinable()) {
+      thread_.join();
+    }
     return status_;
   }
 
@@ -209,7 +223,9 @@ class FileWriterThread {
   };
   void Run() {
     while (auto job = queue_.Pop()) {
-      if (!status_.ok()) continue;  // drain after an error
+      if (!status_.ok()) {
+        continue;  // drain after an error
+      }
       status_ = WriteFrameFiles(root_, options_, job->k, job->image, job->mask, job->depth);
     }
   }
@@ -224,7 +240,9 @@ class FileWriterThread {
 Status MakeDirs(const std::string& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec) return Status::Error("cannot create " + dir + ": " + ec.message());
+  if (ec) {
+    return Status::Error("cannot create " + dir + ": " + ec.message());
+  }
   return Status::Ok();
 }
 
@@ -232,25 +250,35 @@ Status MakeDirs(const std::string& dir) {
 
 Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWriterOptions& options,
                      SequenceSummary* summary, const std::function<void(int)>& progress) {
-  if (!options.Check()) return Status::Error("sequence writer options: " + LastOptionError());
+  if (!options.Check()) {
+    return Status::Error("sequence writer options: " + LastOptionError());
+  }
   const int64_t t_start = MonotonicUtime();
   *summary = SequenceSummary();
   MBSLAM_RETURN_IF_ERROR(MakeDirs(dir));
   const fs::path root(dir);
   if (options.write_files) {
     MBSLAM_RETURN_IF_ERROR(MakeDirs((root / "images").string()));
-    if (options.write_masks) MBSLAM_RETURN_IF_ERROR(MakeDirs((root / "masks").string()));
-    if (options.write_depth) MBSLAM_RETURN_IF_ERROR(MakeDirs((root / "depth").string()));
+    if (options.write_masks) {
+      MBSLAM_RETURN_IF_ERROR(MakeDirs((root / "masks").string()));
+    }
+    if (options.write_depth) {
+      MBSLAM_RETURN_IF_ERROR(MakeDirs((root / "depth").string()));
+    }
   }
   std::unique_ptr<LcmLogWriter> log;
   if (options.write_lcm) {
     Status st;
     log = LcmLogWriter::Open((root / "sequence.lcmlog").string(), &st);
-    if (!log) return st;
+    if (!log) {
+      return st;
+    }
   }
 
   std::unique_ptr<FileWriterThread> files;
-  if (options.write_files) files = std::make_unique<FileWriterThread>(root, options);
+  if (options.write_files) {
+    files = std::make_unique<FileWriterThread>(root, options);
+  }
   const std::vector<int> ids = sim->MovingBodyIds();
   summary->frames_visible.assign(ids.size(), 0);
   eval::Trajectory cam_traj;
@@ -272,7 +300,9 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
     summary->min_moving_fraction = std::min(summary->min_moving_fraction, fraction);
     summary->max_moving_fraction = std::max(summary->max_moving_fraction, fraction);
     for (size_t i = 0; i < frame.bodies.size(); ++i) {
-      if (frame.bodies[i].visible) ++summary->frames_visible[i];
+      if (frame.bodies[i].visible) {
+        ++summary->frames_visible[i];
+      }
       object_traj[i].push_back({frame.utime, frame.bodies[i].world_from_body});
     }
     cam_traj.push_back({frame.utime, frame.world_from_cam});
@@ -304,7 +334,9 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
                                         MakeGroundTruthMessage(frame, sim->scene().scenario)));
     }
     ++summary->frames;
-    if (progress) progress(k);
+    if (progress) {
+      progress(k);
+    }
   }
   if (log) {
     while (next_odometry < odometry.size()) {
@@ -316,7 +348,9 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
     summary->lcm_events = log->events_written();
     log.reset();
   }
-  if (files) MBSLAM_RETURN_IF_ERROR(files->Finish());
+  if (files) {
+    MBSLAM_RETURN_IF_ERROR(files->Finish());
+  }
   summary->odometry_samples = static_cast<int>(odometry.size());
   summary->mean_moving_fraction = summary->frames > 0 ? fraction_sum / summary->frames : 0.0;
 
@@ -348,12 +382,18 @@ Status WriteSequence(Simulator* sim, const std::string& dir, const SequenceWrite
           "\n    first_frame: 0\n    last_frame: " + std::to_string(sim->num_frames() - 1) +
           "\n    frames_visible: " + std::to_string(summary->frames_visible[i]) + "\n";
     }
-    if (ids.empty()) objects_yaml += "  []\n";
+    if (ids.empty()) {
+      objects_yaml += "  []\n";
+    }
     MBSLAM_RETURN_IF_ERROR(WriteStringAtomically((root / "objects.yaml").string(), objects_yaml));
     if (sim->has_odometry()) {
       eval::Trajectory noisy, truth;
-      for (const auto& o : sim->odometry()) noisy.push_back({o.utime, o.odom_from_base});
-      for (const auto& o : sim->odometry_truth()) truth.push_back({o.utime, o.odom_from_base});
+      for (const auto& o : sim->odometry()) {
+        noisy.push_back({o.utime, o.odom_from_base});
+      }
+      for (const auto& o : sim->odometry_truth()) {
+        truth.push_back({o.utime, o.odom_from_base});
+      }
       MBSLAM_RETURN_IF_ERROR(eval::WriteTumTrajectory((root / "odometry.tum").string(), noisy,
                                                       "odom_from_base, wheel odometry with noise"));
       MBSLAM_RETURN_IF_ERROR(eval::WriteTumTrajectory((root / "odometry_truth.tum").string(), truth,

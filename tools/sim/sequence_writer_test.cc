@@ -136,7 +136,9 @@ TEST(SequenceWriter, FolderAndLogMatchTheSimulator) {
       EXPECT_EQ(msg.encoding, mbslam::image_t::ENCODING_GRAY8);
       EXPECT_EQ(msg.size, 160 * 120);
       EXPECT_EQ(msg.row_stride, 160);
-      if (msg.seq == 0) calibration_before_first_image = count["CAMERA_CALIBRATION"] == 1;
+      if (msg.seq == 0) {
+        calibration_before_first_image = count["CAMERA_CALIBRATION"] == 1;
+      }
       if (msg.seq == 39) {
         const cv::Mat m(120, 160, CV_8UC1, const_cast<uint8_t*>(msg.data.data()));
         EXPECT_EQ(cv::norm(m, f.image_gray, cv::NORM_INF), 0.0);

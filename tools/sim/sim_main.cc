@@ -59,7 +59,9 @@ bool g_quiet = false;
 // The human summary (suppressed by --quiet).
 void Say(const char* format, ...) __attribute__((format(printf, 1, 2)));
 void Say(const char* format, ...) {
-  if (g_quiet) return;
+  if (g_quiet) {
+    return;
+  }
   va_list args;
   va_start(args, format);
   std::vprintf(format, args);
@@ -72,7 +74,7 @@ bool ParseSize(const std::string& text, int* w, int* h) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int Main(int argc, char** argv) {
   sim::SimOptions options;
   sim::SequenceWriterOptions writer;
   std::string out_dir, config, json_file;
@@ -92,49 +94,49 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--list")
+    if (a == "--list") {
       list = true;
-    else if (a == "--scenario")
+    } else if (a == "--scenario") {
       scenario = next();
-    else if (a == "--out")
+    } else if (a == "--out") {
       out_dir = next();
-    else if (a == "--config")
+    } else if (a == "--config") {
       config = next();
-    else if (a == "--print-config")
+    } else if (a == "--print-config") {
       print_config = true;
-    else if (a == "--frames")
+    } else if (a == "--frames") {
       frames = std::atoi(next().c_str());
-    else if (a == "--size")
+    } else if (a == "--size") {
       size = next();
-    else if (a == "--fps")
+    } else if (a == "--fps") {
       fps = std::atof(next().c_str());
-    else if (a == "--seed")
+    } else if (a == "--seed") {
       seed = std::atoll(next().c_str());
-    else if (a == "--noise")
+    } else if (a == "--noise") {
       noise = std::atof(next().c_str());
-    else if (a == "--blur")
+    } else if (a == "--blur") {
       blur = std::atoi(next().c_str());
-    else if (a == "--color")
+    } else if (a == "--color") {
       writer.color_images = true;
-    else if (a == "--depth")
+    } else if (a == "--depth") {
       writer.depth_format = next();
-    else if (a == "--image-encoding")
+    } else if (a == "--image-encoding") {
       writer.lcm_image_encoding = next();
-    else if (a == "--no-files")
+    } else if (a == "--no-files") {
       writer.write_files = false;
-    else if (a == "--no-lcm")
+    } else if (a == "--no-lcm") {
       writer.write_lcm = false;
-    else if (a == "--check")
+    } else if (a == "--check") {
       check = true;
-    else if (a == "--check-frames")
+    } else if (a == "--check-frames") {
       check_frames = std::atoi(next().c_str());
-    else if (a == "--quiet")
+    } else if (a == "--quiet") {
       quiet = true;
-    else if (a == "--verbose")
+    } else if (a == "--verbose") {
       mbslam::SetLogLevel(mbslam::LogLevel::kDebug);
-    else if (a == "--json")
+    } else if (a == "--json") {
       json_file = next();
-    else if (a == "-h" || a == "--help") {
+    } else if (a == "-h" || a == "--help") {
       Usage();
       return 0;
     } else {
@@ -144,7 +146,9 @@ int main(int argc, char** argv) {
     }
   }
   g_quiet = quiet;
-  if (quiet) mbslam::SetLogLevel(mbslam::LogLevel::kWarning);
+  if (quiet) {
+    mbslam::SetLogLevel(mbslam::LogLevel::kWarning);
+  }
   if (list) {
     for (const auto& n : sim::ScenarioNames()) {
       std::printf("  %-18s %s\n", n.c_str(), sim::ScenarioDescription(n).c_str());
@@ -158,12 +162,24 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (!scenario.empty()) options.scenario = scenario;
-  if (frames > 0) options.num_frames = frames;
-  if (fps > 0.0) options.fps = fps;
-  if (seed >= 0) options.seed = seed;
-  if (noise >= 0.0) options.image.noise_sigma = noise;
-  if (blur > 0) options.image.motion_blur_samples = blur;
+  if (!scenario.empty()) {
+    options.scenario = scenario;
+  }
+  if (frames > 0) {
+    options.num_frames = frames;
+  }
+  if (fps > 0.0) {
+    options.fps = fps;
+  }
+  if (seed >= 0) {
+    options.seed = seed;
+  }
+  if (noise >= 0.0) {
+    options.image.noise_sigma = noise;
+  }
+  if (blur > 0) {
+    options.image.motion_blur_samples = blur;
+  }
   if (!size.empty() && !ParseSize(size, &options.camera.width, &options.camera.height)) {
     std::cerr << "mbslam-sim: --size wants WxH, got '" << size << "'\n";
     return 2;
@@ -207,7 +223,9 @@ int main(int argc, char** argv) {
   if (!out_dir.empty()) {
     sim::SequenceSummary summary;
     status = sim::WriteSequence(simulator.get(), out_dir, writer, &summary, [&](int k) {
-      if ((k + 1) % 50 == 0) MBSLAM_LOG(INFO) << "frame " << k + 1 << " / " << options.num_frames;
+      if ((k + 1) % 50 == 0) {
+        MBSLAM_LOG(INFO) << "frame " << k + 1 << " / " << options.num_frames;
+      }
     });
     if (!status.ok()) {
       std::cerr << "mbslam-sim: " << status.message() << "\n";
@@ -230,7 +248,9 @@ int main(int argc, char** argv) {
     }
     visible += "]";
     Say("  frames in which each mover is visible: %s\n", visible.c_str());
-    if (summary.odometry_samples > 0) Say("  odometry samples: %d\n", summary.odometry_samples);
+    if (summary.odometry_samples > 0) {
+      Say("  odometry samples: %d\n", summary.odometry_samples);
+    }
     json += ", \"out\": \"" + out_dir + "\", \"render_fps\": " + std::to_string(fps_render) +
             ", \"total_fps\": " + std::to_string(fps_total) +
             ", \"mean_moving_fraction\": " + std::to_string(summary.mean_moving_fraction) +
@@ -249,8 +269,9 @@ int main(int argc, char** argv) {
           n == 1 ? 0
                  : static_cast<int>(static_cast<int64_t>(i) * (options.num_frames - 1) / (n - 1));
       status = simulator->RenderFrame(k, &frame, sim::RenderRequest{false, true});
-      if (status.ok())
+      if (status.ok()) {
         status = sim::CheckFrameGroundTruth(*simulator, frame, check_options, &report);
+      }
       if (!status.ok()) {
         std::cerr << "mbslam-sim: " << status.message() << "\n";
         return 1;
@@ -282,6 +303,17 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  if (!quiet) std::cout << json << std::endl;
+  if (!quiet) {
+    std::cout << json << std::endl;
+  }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return Main(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "mbslam-sim: " << e.what() << "\n";
+    return 1;
+  }
 }

@@ -31,7 +31,9 @@ int64_t SimOptions::FrameUtime(int k) const {
 }
 
 double SimFrame::MovingFraction() const {
-  if (mask.empty()) return 0.0;
+  if (mask.empty()) {
+    return 0.0;
+  }
   return static_cast<double>(cv::countNonZero(mask)) / static_cast<double>(mask.total());
 }
 
@@ -46,13 +48,21 @@ std::unique_ptr<Simulator> Simulator::Create(const SimOptions& options, Status* 
   sim->options_ = options;
   sim->intrinsics_ = options.camera.Intrinsics();
   *status = sim->intrinsics_.Validate();
-  if (!status->ok()) return nullptr;
+  if (!status->ok()) {
+    return nullptr;
+  }
   *status = BuildScenario(options, &sim->scene_);
-  if (!status->ok()) return nullptr;
+  if (!status->ok()) {
+    return nullptr;
+  }
   sim->renderer_ = Renderer::Create(sim->scene_, sim->intrinsics_, options.image.render, status);
-  if (!sim->renderer_) return nullptr;
+  if (!sim->renderer_) {
+    return nullptr;
+  }
   // The renderer keeps its own copies of the textures: free ours.
-  for (auto& t : sim->scene_.textures) t = cv::Mat();
+  for (auto& t : sim->scene_.textures) {
+    t = cv::Mat();
+  }
 
   const uint64_t seed = static_cast<uint64_t>(options.seed);
   for (size_t b = 0; b < sim->scene_.bodies.size(); ++b) {
@@ -63,7 +73,9 @@ std::unique_ptr<Simulator> Simulator::Create(const SimOptions& options, Status* 
         std::min(is_static ? 2000 : 200, options.max_points_per_body), options.max_points_per_body,
         seed * 1000003ULL + static_cast<uint64_t>(body.id) + 11));
   }
-  if (sim->has_odometry()) sim->GenerateOdometry();
+  if (sim->has_odometry()) {
+    sim->GenerateOdometry();
+  }
   *status = Status::Ok();
   return sim;
 }
@@ -72,14 +84,18 @@ Rigid3d Simulator::WorldFromCam(int64_t utime) const { return scene_.camera.Worl
 
 Rigid3d Simulator::WorldFromBody(int id, int64_t utime) const {
   const int index = scene_.BodyIndex(id);
-  if (index < 0) return Rigid3d();
+  if (index < 0) {
+    return Rigid3d();
+  }
   return scene_.bodies[static_cast<size_t>(index)].track.WorldFromBody(utime);
 }
 
 std::vector<int> Simulator::MovingBodyIds() const {
   std::vector<int> ids;
   for (const auto& b : scene_.bodies) {
-    if (b.id > 0) ids.push_back(b.id);
+    if (b.id > 0) {
+      ids.push_back(b.id);
+    }
   }
   std::sort(ids.begin(), ids.end());
   return ids;
@@ -92,7 +108,9 @@ const std::vector<Eigen::Vector3d>& Simulator::SurfacePoints(int id) const {
 }
 
 std::optional<Rigid3d> Simulator::base_from_cam() const {
-  if (!scene_.base) return std::nullopt;
+  if (!scene_.base) {
+    return std::nullopt;
+  }
   return scene_.base_from_cam;
 }
 
@@ -100,7 +118,9 @@ std::vector<Rigid3d> Simulator::CamFromBodies(int64_t utime) const {
   const Rigid3d cam_from_world = WorldFromCam(utime).Inverse();
   std::vector<Rigid3d> out;
   out.reserve(scene_.bodies.size());
-  for (const auto& b : scene_.bodies) out.push_back(cam_from_world * b.track.WorldFromBody(utime));
+  for (const auto& b : scene_.bodies) {
+    out.push_back(cam_from_world * b.track.WorldFromBody(utime));
+  }
   return out;
 }
 
@@ -117,7 +137,9 @@ Status Simulator::FrameTruth(int k, SimFrame* frame) const {
   frame->cam_angular_velocity = cam.angular_velocity;
   frame->bodies.clear();
   for (const auto& b : scene_.bodies) {
-    if (b.id == 0) continue;
+    if (b.id == 0) {
+      continue;
+    }
     const MotionState s = b.track.StateAt(frame->utime);
     SimBodyState state;
     state.id = b.id;
@@ -147,7 +169,9 @@ Status Simulator::RenderFrame(int k, SimFrame* frame, const RenderRequest& reque
     std::vector<int> counts(65536, 0);
     for (int r = 0; r < frame->mask.rows; ++r) {
       const uint16_t* row = frame->mask.ptr<uint16_t>(r);
-      for (int c = 0; c < frame->mask.cols; ++c) ++counts[row[c]];
+      for (int c = 0; c < frame->mask.cols; ++c) {
+        ++counts[row[c]];
+      }
     }
     for (auto& b : frame->bodies) {
       b.pixel_count = counts[static_cast<size_t>(b.id)];
@@ -224,7 +248,9 @@ void Simulator::GenerateOdometry() {
   for (int64_t j = 0;; ++j) {
     const int64_t t =
         first + static_cast<int64_t>(std::llround(static_cast<double>(j) * 1e6 / o.rate_hz));
-    if (t > last) break;
+    if (t > last) {
+      break;
+    }
     double v_true, w_true;
     measured(t, &v_true, &w_true);
     const double v_m = v_true * speed_scale + o.speed_noise * unit(rng);
