@@ -13,7 +13,7 @@ constexpr double kUsToS = 1e-6;
 // Log-weight of a particle that cannot be measured at all (behind the camera).
 constexpr double kUnmeasurableLogWeight = -1e6;
 // Cells of the numeric integration over the free depth when velocities are seated.
-constexpr int kSeatCells = 16;
+constexpr int kSeatCells = 32;
 
 Eigen::Vector3d Normal3(ParticleRng* rng) {
   return Eigen::Vector3d(rng->Normal(), rng->Normal(), rng->Normal());
@@ -79,6 +79,7 @@ void BearingOnlyTracker::Reset() {
   initialized_ = false;
   seated_ = false;
   orientation_tracked_ = false;
+  camera_velocity_.setZero();
   utime_ = 0;
   init_utime_ = 0;
   plane_.reset();
@@ -336,6 +337,16 @@ void BearingOnlyTracker::HoldOnRay(const BotObservation& o) {
 }
 
 void BearingOnlyTracker::SeatVelocities(const BotObservation& o, const StepCues& c) {
+  // Particle i was at p1 = c1 + z1 r1 at initialisation; the new bearing puts it at
+  // p2 = c2 + z r2 with a free depth z, i.e. velocity v(z) = (p2 - p1) / dt. Its weight is the
+  // marginal likelihood of the two bearings over the velocity prior,
+  //   integral prior(v(z)) z^2 dz   (z^2: volume per depth and image area at p2),
+  // evaluated on kSeatCells cells of the depths whose speed is in [s_min, s_max], and z is
+  // drawn from the same integrand. Prior: uniform speed in all directions, density
+  // ~1/|v|^2; with the ground-plane cue uniform speed and heading in the plane, density
+  // ~1/|v_h|, times a Gaussian on the height change over dt whose sigma is the height
+  // tolerance and the bearing noise at both ends (a far particle's crossing with its own
+  // horizontal plane is too sensitive to the bearing noise to be taken exactly).
   const double dt = static_cast<double>(o.utime - init_utime_) * kUsToS;
   const Rigid3d world_from_cam = o.cam_from_world.Inverse();
   const Eigen::Vector3d c2 = world_from_cam.translation;
@@ -343,101 +354,94 @@ void BearingOnlyTracker::SeatVelocities(const BotObservation& o, const StepCues&
   const double s_min = options_.init_speed_min, s_max = options_.init_speed_max;
   const double floor = options_.prior_speed_floor;
   const double log_violation = std::log(options_.violation_weight);
+  const double sigma_px = o.bearing_sigma_px > 0.0 ? o.bearing_sigma_px : options_.bearing_sigma_px;
+  const double eta = sigma_px / o.focal_px;
+  const Rigid3d init_cam_from_world = init_world_from_cam_.Inverse();
   double z_lo = options_.min_depth, z_hi = std::numeric_limits<double>::infinity();
   if (c.depth) {
     z_lo = std::max(z_lo, c.z_min);
     z_hi = std::min(z_hi, c.z_max);
   }
+  const Eigen::Vector3d n = c.plane.normal;
   int violations = 0;
   for (BotParticle& p : particles_) {
     const Eigen::Vector3d p1 = p.init_position;
-    bool feasible = false;
-    double z = 0.0;
-    double log_w = 0.0;
-    if (c.ground) {
-      // Velocity in the plane: the particle keeps its height, so the new bearing meets its
-      // plane at one depth. Prior density ~1/|v| (uniform speed, uniform heading), area on
-      // the plane per image area z^3 / D (D: camera height above the particle's plane).
-      const double denom = c.plane.normal.dot(r2);
-      const double rise = p.ground_height - c.plane.Height(c2);
-      if (std::abs(denom) > 1e-9) {
-        z = rise / denom;
-        if (std::isfinite(z) && z >= z_lo && z <= z_hi) {
-          const Eigen::Vector3d v = InPlane((c2 + z * r2 - p1) / dt, c.plane.normal);
-          const double speed = v.norm();
-          if (speed >= s_min && speed <= s_max) {
-            feasible = true;
-            log_w = 3.0 * std::log(z) - std::log(std::max(std::abs(rise), 1e-6)) -
-                    std::log(std::max(speed, floor));
-          }
-        }
+    const double z1 = std::max(init_cam_from_world.translation.z() +
+                                   init_cam_from_world.rotation.toRotationMatrix().row(2).dot(p1),
+                               options_.min_depth);
+    // Depths where |v| <= s_max (a superset in the plane mode), minus |v| < s_min (3D).
+    const Eigen::Vector3d a = c2 - p1;
+    const double A = r2.squaredNorm(), B = a.dot(r2), C = a.squaredNorm();
+    std::vector<std::pair<double, double>> segments;
+    const double outer = B * B - A * (C - s_max * s_max * dt * dt);
+    if (outer > 0.0) {
+      const double lo = (-B - std::sqrt(outer)) / A, hi = (-B + std::sqrt(outer)) / A;
+      const double inner =
+          (s_min > 0.0 && !c.ground) ? B * B - A * (C - s_min * s_min * dt * dt) : -1.0;
+      if (inner > 0.0) {
+        segments.push_back({lo, (-B - std::sqrt(inner)) / A});
+        segments.push_back({(-B + std::sqrt(inner)) / A, hi});
+      } else {
+        segments.push_back({lo, hi});
       }
-      if (!feasible) z = std::clamp(std::isfinite(z) && z > 0.0 ? z : z_lo, z_lo, z_lo + 1e3);
-    } else {
-      // Free velocity: the new depth z is free; the speed prior (density ~1/|v|^2) limits it
-      // to the depths where |c2 + z r2 - p1| / dt lies in [s_min, s_max]. Weight: the
-      // integral of prior(v(z)) z^2 dz over them (z^2: volume per depth and image area).
-      const Eigen::Vector3d a = c2 - p1;
-      const double A = r2.squaredNorm(), B = a.dot(r2), C = a.squaredNorm();
-      std::vector<std::pair<double, double>> segments;
-      const double outer = B * B - A * (C - s_max * s_max * dt * dt);
-      if (outer > 0.0) {
-        const double lo = (-B - std::sqrt(outer)) / A, hi = (-B + std::sqrt(outer)) / A;
-        const double inner = s_min > 0.0 ? B * B - A * (C - s_min * s_min * dt * dt) : -1.0;
-        if (inner > 0.0) {
-          segments.push_back({lo, (-B - std::sqrt(inner)) / A});
-          segments.push_back({(-B + std::sqrt(inner)) / A, hi});
-        } else {
-          segments.push_back({lo, hi});
-        }
-      }
-      double length = 0.0;
-      for (auto& s : segments) {
-        s.first = std::max(s.first, z_lo);
-        s.second = std::min(s.second, z_hi);
-        if (s.second > s.first) length += s.second - s.first;
-      }
-      if (length > 0.0) {
-        // Piecewise-constant integrand on kSeatCells cells of the feasible depths.
-        double g[kSeatCells];
-        double z_at[kSeatCells];
-        double total = 0.0;
-        const double cell = length / kSeatCells;
-        for (int k = 0; k < kSeatCells; ++k) {
-          double u = (k + 0.5) * cell;
-          double zk = z_lo;
-          for (const auto& s : segments) {
-            if (s.second <= s.first) continue;
-            if (u <= s.second - s.first) {
-              zk = s.first + u;
-              break;
-            }
-            u -= s.second - s.first;
-          }
-          const double speed = std::max((a + zk * r2).norm() / dt, floor);
-          z_at[k] = zk;
-          g[k] = zk * zk / (speed * speed);
-          total += g[k];
-        }
-        if (total > 0.0) {
-          feasible = true;
-          log_w = std::log(total * cell);
-          double u = rng_.Uniform() * total;
-          int k = 0;
-          while (k < kSeatCells - 1 && u > g[k]) u -= g[k++];
-          z = z_at[k] + (rng_.Uniform() - 0.5) * cell;  // within the cell (approximately)
-          z = std::max(z, z_lo);
-        }
-      }
-      if (!feasible) z = std::clamp(std::max(-B / A, z_lo), z_lo, z_lo + 1e3);
     }
+    double length = 0.0;
+    for (auto& seg : segments) {
+      seg.first = std::max(seg.first, z_lo);
+      seg.second = std::min(seg.second, z_hi);
+      if (seg.second > seg.first) length += seg.second - seg.first;
+    }
+    bool feasible = false;
+    double z = 0.0, log_w = 0.0;
+    if (length > 0.0) {
+      double g[kSeatCells];
+      double z_at[kSeatCells];
+      double total = 0.0;
+      const double cell = length / kSeatCells;
+      for (int k = 0; k < kSeatCells; ++k) {
+        double u = (k + 0.5) * cell;
+        double zk = z_lo;
+        for (const auto& seg : segments) {
+          if (seg.second <= seg.first) continue;
+          if (u <= seg.second - seg.first) {
+            zk = seg.first + u;
+            break;
+          }
+          u -= seg.second - seg.first;
+        }
+        const Eigen::Vector3d v = (a + zk * r2) / dt;
+        double density = 0.0;
+        if (c.ground) {
+          const double v_n = n.dot(v);
+          const double speed = (v - v_n * n).norm();
+          if (speed >= s_min && speed <= s_max) {
+            const double sigma_h = std::sqrt(c.height_tolerance * c.height_tolerance +
+                                             eta * eta * (z1 * z1 + zk * zk)) / dt;
+            density = std::exp(-0.5 * v_n * v_n / (sigma_h * sigma_h)) / sigma_h /
+                      std::max(speed, floor);
+          }
+        } else {
+          const double speed = std::max(v.norm(), floor);
+          density = 1.0 / (speed * speed);
+        }
+        z_at[k] = zk;
+        g[k] = zk * zk * density;
+        total += g[k];
+      }
+      if (total > 0.0) {
+        feasible = true;
+        log_w = std::log(total * cell);
+        double u = rng_.Uniform() * total;
+        int k = 0;
+        while (k < kSeatCells - 1 && u > g[k]) u -= g[k++];
+        z = std::max(z_at[k] + (rng_.Uniform() - 0.5) * cell, z_lo);
+      }
+    }
+    if (!feasible) z = std::clamp(-B / A, z_lo, std::max(z_lo, std::min(z_hi, z_lo + 1e3)));
     p.position = c2 + z * r2;
     Eigen::Vector3d v = (p.position - p1) / dt;
-    if (c.ground) {
-      v = InPlane(v, c.plane.normal);
-    } else if (c.has_plane) {
-      p.ground_height = c.plane.Height(p.position);
-    }
+    if (c.has_plane) p.ground_height = c.plane.Height(p.position);
+    if (c.ground) v = InPlane(v, n);
     if (!feasible) {
       // No velocity within the speed prior carries this particle onto the bearing.
       const double speed = v.norm();
@@ -534,11 +538,14 @@ void BearingOnlyTracker::ApplySfmMotion(const BotObservation& o) {
   now.world_from_obj_rotation =
       (now.world_from_cam.rotation * o.sfm->cam_from_obj.rotation).normalized();
 
-  // The SfM-implied twist over at least the baseline: the newest older image that far back.
+  // The SfM-implied twist over at least the baseline: the newest older image that far back
+  // (none yet: a twist from images closer in time is mostly the reconstruction's noise).
   const SfmState* ref = nullptr;
   for (auto it = sfm_history_.rbegin(); it != sfm_history_.rend(); ++it) {
-    if (it->utime < o.utime) ref = &*it;
-    if (o.utime - it->utime >= options_.sfm_velocity_baseline_us) break;
+    if (it->utime < o.utime && o.utime - it->utime >= options_.sfm_velocity_baseline_us) {
+      ref = &*it;
+      break;
+    }
   }
   const Eigen::Matrix3d R_cw = o.cam_from_world.RotationMatrix();
   const Eigen::Vector3d t_cw = o.cam_from_world.translation;
@@ -575,9 +582,9 @@ void BearingOnlyTracker::ApplySfmMotion(const BotObservation& o) {
   }
 }
 
-void BearingOnlyTracker::NormalizeAndResample() {
+bool BearingOnlyTracker::NormalizeAndResample() {
   const size_t n = particles_.size();
-  if (n == 0) return;
+  if (n == 0) return false;
   double max_log = -std::numeric_limits<double>::infinity();
   for (const BotParticle& p : particles_) max_log = std::max(max_log, p.log_weight);
   std::vector<double> w(n);
@@ -594,7 +601,7 @@ void BearingOnlyTracker::NormalizeAndResample() {
   }
   const double ess = 1.0 / sum_sq;
   stats_.last_ess = ess;
-  if (ess >= options_.resample_ess_ratio * static_cast<double>(n)) return;
+  if (ess >= options_.resample_ess_ratio * static_cast<double>(n)) return false;
 
   // Systematic resampling: one uniform offset, n equally spaced positions on the CDF.
   std::vector<BotParticle> next;
@@ -612,6 +619,42 @@ void BearingOnlyTracker::NormalizeAndResample() {
   for (BotParticle& p : next) p.log_weight = log_uniform;
   particles_.swap(next);
   ++stats_.resamplings;
+  return true;
+}
+
+void BearingOnlyTracker::RegularizeDepths(const StepCues& cues) {
+  const size_t n = particles_.size();
+  if (options_.depth_regularization <= 0.0 || n < 2 || !cues.has_camera) return;
+  std::vector<double> log_z(n);
+  double mean = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double z = cues.Depth(particles_[i].position);
+    if (!(z > 0.0)) return;
+    log_z[i] = std::log(z);
+    mean += log_z[i];
+  }
+  mean /= static_cast<double>(n);  // weights are uniform right after resampling
+  double var = 0.0;
+  for (double l : log_z) var += (l - mean) * (l - mean);
+  const double sigma = std::sqrt(var / static_cast<double>(n));
+  // Silverman's bandwidth for one dimension, Liu-West shrinkage a = sqrt(1 - h^2).
+  const double h = std::min(0.9, options_.depth_regularization * std::pow(4.0 / 3.0, 0.2) *
+                                     std::pow(static_cast<double>(n), -0.2));
+  const double a = std::sqrt(1.0 - h * h);
+  for (size_t i = 0; i < n; ++i) {
+    BotParticle& p = particles_[i];
+    const double target = a * log_z[i] + (1.0 - a) * mean + h * sigma * rng_.Normal();
+    const double f = std::exp(target - log_z[i]);
+    BotParticle moved = p;
+    moved.position = cues.center + f * (p.position - cues.center);
+    moved.linear_velocity = camera_velocity_ + f * (p.linear_velocity - camera_velocity_);
+    if (cues.has_plane) {
+      moved.ground_height = cues.plane.Height(moved.position);
+      if (cues.ground) moved.linear_velocity = InPlane(moved.linear_velocity, cues.plane.normal);
+    }
+    moved.sfm_scale *= f;
+    if (InPsi(moved, cues)) p = moved;
+  }
 }
 
 Status BearingOnlyTracker::Update(const BotObservation& o) {
@@ -629,6 +672,9 @@ Status BearingOnlyTracker::Update(const BotObservation& o) {
   RebaseGroundHeights(o.ground_plane);
   const StepCues cues = MakeCues(&o);
   ++stats_.updates;
+  if (dt > 0.0) {
+    camera_velocity_ = (cues.center - cam_from_world_.Inverse().translation) / dt;
+  }
   utime_ = o.utime;
   cam_from_world_ = o.cam_from_world;
 
@@ -638,7 +684,7 @@ Status BearingOnlyTracker::Update(const BotObservation& o) {
       return Status::Ok();
     }
     SeatVelocities(o, cues);
-    NormalizeAndResample();
+    if (NormalizeAndResample()) RegularizeDepths(cues);
     ApplySfmMotion(o);
     return Status::Ok();
   }
@@ -647,7 +693,7 @@ Status BearingOnlyTracker::Update(const BotObservation& o) {
   Propagate(dt, cues, &violated);
   WeightBySfm(o);
   WeightByBearing(o, violated);
-  NormalizeAndResample();
+  if (NormalizeAndResample()) RegularizeDepths(cues);
   ApplySfmMotion(o);
   return Status::Ok();
 }
@@ -829,6 +875,7 @@ void BearingOnlyTracker::RescaleWorld(double factor) {
   if (plane_) plane_->Rescale(factor);
   init_world_from_cam_.translation *= factor;
   cam_from_world_.translation *= factor;
+  camera_velocity_ *= factor;
   for (SfmState& s : sfm_history_) s.world_from_cam.translation *= factor;
 }
 

@@ -19,7 +19,13 @@
 //
 // Measurement (eq. 5.2): z_i = project(cam_from_world * translation(g_i)) in normalised
 // image coordinates; log-weight -|z - z_i|^2 / (2 eta^2), eta = bearing_sigma_px / focal.
-// Systematic resampling when the effective sample size falls below a share of N.
+// Systematic resampling when the effective sample size falls below a share of N, then a
+// regularisation along the unobservable direction: each particle slides along its viewing
+// ray by a log-depth kernel with Liu-West shrinkage (mean and spread of the log-depths are
+// kept), its velocity rescaled along the same one-parameter family (v_cam + f (v - v_cam)),
+// so that duplicates of a few survivors spread again in depth and the cloud can follow
+// evidence that arrives later (without it, particles near the truth that a wide prior
+// down-weighted early are lost for good).
 //
 // Initialisation (sec. 5.1.2): depths uniform in [d_min, d_max] along the viewing ray (the
 // depth bound when given), or N(d, sigma^2) around the mapped depth of a previously static
@@ -109,6 +115,7 @@ struct BearingOnlyTrackerOptions {
   double bearing_sigma_px = 2.0;            // eta: bearing noise of the reference point (px)
   double min_depth = 0.2;                   // particles nearer than this to the camera are invalid (units)
   double resample_ess_ratio = 0.5;          // resample when ESS < ratio * N (0, 1]
+  double depth_regularization = 1.0;        // after resampling, log-depth kernel of this x Silverman's bandwidth (0 = off)
   double lost_residual_px = 40.0;           // no particle this close to the bearing: particles move onto the ray (px)
   // Truncated sampling (sec. 5.1.3).
   int max_rejection_tries = 10;             // redraws to satisfy the cue set psi (count)
@@ -147,6 +154,7 @@ struct BearingOnlyTrackerOptions {
     MBSLAM_CHECK_OPTION_GT(bearing_sigma_px, 0.0);
     MBSLAM_CHECK_OPTION_GT(min_depth, 0.0);
     MBSLAM_CHECK_OPTION(resample_ess_ratio > 0.0 && resample_ess_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION(depth_regularization >= 0.0 && depth_regularization < 3.0);
     MBSLAM_CHECK_OPTION_GT(lost_residual_px, 0.0);
     MBSLAM_CHECK_OPTION_GE(max_rejection_tries, 1);
     MBSLAM_CHECK_OPTION(violation_weight > 0.0 && violation_weight <= 1.0);
@@ -185,6 +193,8 @@ struct BearingOnlyTrackerOptions {
     v("bearing_sigma_px", &bearing_sigma_px, "eta: bearing noise of the reference point (px)");
     v("min_depth", &min_depth, "particles nearer than this are invalid (units)");
     v("resample_ess_ratio", &resample_ess_ratio, "resample when ESS < ratio * N (0, 1]");
+    v("depth_regularization", &depth_regularization,
+      "log-depth kernel after resampling, x Silverman's bandwidth (0 = off)");
     v("lost_residual_px", &lost_residual_px, "no particle this close: particles move onto the ray (px)");
     v("max_rejection_tries", &max_rejection_tries, "redraws to satisfy the cue set (count)");
     v("violation_weight", &violation_weight, "weight factor of a particle outside the cue set (0, 1]");
@@ -343,7 +353,9 @@ class BearingOnlyTracker {
   void WeightBySfm(const BotObservation& observation);
   void ApplySfmMotion(const BotObservation& observation);
   void RebaseGroundHeights(const std::optional<GroundPlane>& plane);
-  void NormalizeAndResample();
+  // Returns true when it resampled.
+  bool NormalizeAndResample();
+  void RegularizeDepths(const StepCues& cues);
   // Deterministic weighted subsample: indices at CDF positions (k + 0.5) / count.
   std::vector<int> SystematicIndices(int count) const;
 
@@ -359,6 +371,7 @@ class BearingOnlyTracker {
   int64_t init_utime_ = 0;
   Rigid3d init_world_from_cam_;
   Rigid3d cam_from_world_;
+  Eigen::Vector3d camera_velocity_ = Eigen::Vector3d::Zero();  // world (units/s)
   std::optional<GroundPlane> plane_;  // the plane the particles' ground heights refer to
   std::deque<SfmState> sfm_history_;  // recent SfM images of the current reconstruction
   BotStats stats_;

@@ -4,11 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <unordered_set>
 #include <utility>
 
 #include "common/util/atomic_file.h"
 #include "common/util/logging.h"
+#include "services/perception/occupancy/octree_ops.h"
 
 namespace mbslam {
 namespace {
@@ -68,7 +69,9 @@ OccupancyInsertSummary OccupancyMap::InsertRays(
     }
     batch.ends.push_back(p.cast<float>());
   }
-  if (batch.ends.empty()) return summary;
+  if (batch.ends.empty()) {
+    return summary;
+  }
 
   if (!tree_) {
     // Up to scale, resolution not fixed yet: collect rays until their median length
@@ -83,9 +86,8 @@ OccupancyInsertSummary OccupancyMap::InsertRays(
                                    ? options_.max_range_depth_multiple * median
                                    : (options_.max_range_m > 0.0 ? options_.max_range_m : -1.0);
       if (resolution > 0.0 && std::isfinite(resolution)) {
-        MBSLAM_LOG(INFO) << "occupancy: median ray length " << median
-                         << " map units: voxel edge " << resolution << ", range bound "
-                         << max_range;
+        MBSLAM_LOG(INFO) << "occupancy: median ray length " << median << " map units: voxel edge "
+                         << resolution << ", range bound " << max_range;
         Rebuild(resolution, max_range);
         summary.rays_inserted = static_cast<int>(stored_rays_);
         StoreBatch(RayBatch());  // applies the bound on stored rays
@@ -96,43 +98,82 @@ OccupancyInsertSummary OccupancyMap::InsertRays(
   }
 
   InsertBatch(batch, &summary);
-  if (options_.max_stored_rays > 0) StoreBatch(std::move(batch));
+  if (options_.max_stored_rays > 0) {
+    StoreBatch(std::move(batch));
+  }
   ++revision_;
-  num_occupied_cache_.reset();
   return summary;
 }
 
 void OccupancyMap::InsertBatch(const RayBatch& batch, OccupancyInsertSummary* summary) {
+  // OctoMap's insertPointCloud (computeUpdate / computeDiscreteUpdate, then one update
+  // per voxel, occupied before free), with the update step done in one depth-first walk
+  // (octree_ops.h). Coordinates outside the tree's range are rejected here instead of
+  // letting OctoMap print a warning per ray.
   const octomap::point3d origin = ToOcto(batch.origin);
   octomap::OcTreeKey key;
   if (!tree_->coordToKeyChecked(origin, key)) {
     summary->rays_rejected += static_cast<int>(batch.ends.size());
     return;
   }
-  octomap::Pointcloud cloud;
-  cloud.reserve(batch.ends.size());
-  const Eigen::Vector3f origin_f = batch.origin.cast<float>();
-  for (const Eigen::Vector3f& end : batch.ends) {
-    const Eigen::Vector3f ray = end - origin_f;
-    const float length = ray.norm();
-    Eigen::Vector3f last = end;  // the farthest point the ray updates
-    const bool truncated = max_range_ > 0.0 && length > max_range_;
-    if (truncated) last = origin_f + ray * static_cast<float>(max_range_ / length);
-    if (!tree_->coordToKeyChecked(octomap::point3d(last.x(), last.y(), last.z()), key)) {
-      ++summary->rays_rejected;  // outside the tree's coordinate range
+  std::vector<octomap::point3d> ends;
+  ends.reserve(batch.ends.size());
+  std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash> end_voxels;
+  for (const Eigen::Vector3f& e : batch.ends) {
+    const octomap::point3d p(e.x(), e.y(), e.z());
+    // Discretised: one ray per end voxel, to its centre (points outside the tree's
+    // range go on as they are and are rejected below).
+    if (options_.discretize && tree_->coordToKeyChecked(p, key)) {
+      if (end_voxels.insert(key).second) {
+        ends.push_back(tree_->keyToCoord(key));
+      } else {
+        ++summary->rays_inserted;  // merged into an earlier ray to the same voxel
+      }
       continue;
     }
-    if (truncated) ++summary->rays_truncated;
-    cloud.push_back(end.x(), end.y(), end.z());
+    ends.push_back(p);
   }
-  if (cloud.size() == 0) return;
-  tree_->insertPointCloud(cloud, origin, max_range_, /*lazy_eval=*/false, options_.discretize);
-  summary->rays_inserted += static_cast<int>(cloud.size());
+  if (!key_ray_) {
+    key_ray_ = std::make_unique<octomap::KeyRay>();
+  }
+  updates_.clear();
+  for (const octomap::point3d& p : ends) {
+    if (max_range_ < 0.0 || (p - origin).norm() <= max_range_) {
+      octomap::OcTreeKey end_key;
+      if (!tree_->coordToKeyChecked(p, end_key)) {
+        ++summary->rays_rejected;
+        continue;
+      }
+      if (tree_->computeRayKeys(origin, p, *key_ray_)) {
+        for (const octomap::OcTreeKey& k : *key_ray_) {
+          updates_.push_back(VoxelUpdate(k, false));
+        }
+      }
+      updates_.push_back(VoxelUpdate(end_key, true));
+    } else {
+      const octomap::point3d direction = (p - origin).normalized();
+      const octomap::point3d last = origin + direction * static_cast<float>(max_range_);
+      if (!tree_->coordToKeyChecked(last, key)) {
+        ++summary->rays_rejected;
+        continue;
+      }
+      if (tree_->computeRayKeys(origin, last, *key_ray_)) {
+        for (const octomap::OcTreeKey& k : *key_ray_) {
+          updates_.push_back(VoxelUpdate(k, false));
+        }
+      }
+      ++summary->rays_truncated;
+    }
+    ++summary->rays_inserted;
+  }
+  num_occupied_ += ApplyVoxelUpdates(tree_.get(), &updates_);
 }
 
 void OccupancyMap::StoreBatch(RayBatch batch) {
   stored_rays_ += static_cast<int64_t>(batch.ends.size());
-  if (!batch.ends.empty()) batches_.push_back(std::move(batch));
+  if (!batch.ends.empty()) {
+    batches_.push_back(std::move(batch));
+  }
   while (!batches_.empty() && stored_rays_ > options_.max_stored_rays) {
     const int64_t n = static_cast<int64_t>(batches_.front().ends.size());
     stored_rays_ -= n;
@@ -146,9 +187,13 @@ double OccupancyMap::MedianStoredRayLength() const {
   lengths.reserve(static_cast<size_t>(stored_rays_));
   for (const RayBatch& batch : batches_) {
     const Eigen::Vector3f origin = batch.origin.cast<float>();
-    for (const Eigen::Vector3f& end : batch.ends) lengths.push_back((end - origin).norm());
+    for (const Eigen::Vector3f& end : batch.ends) {
+      lengths.push_back((end - origin).norm());
+    }
   }
-  if (lengths.empty()) return 0.0;
+  if (lengths.empty()) {
+    return 0.0;
+  }
   auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
   std::nth_element(lengths.begin(), mid, lengths.end());
   return *mid;
@@ -162,9 +207,11 @@ void OccupancyMap::Rebuild(double resolution, double max_range) {
   tree_->setClampingThresMax(options_.clamping_max);
   tree_->setOccupancyThres(options_.occupancy_threshold);
   max_range_ = max_range;
+  num_occupied_ = 0;
   OccupancyInsertSummary ignored;
-  for (const RayBatch& batch : batches_) InsertBatch(batch, &ignored);
-  num_occupied_cache_.reset();
+  for (const RayBatch& batch : batches_) {
+    InsertBatch(batch, &ignored);
+  }
 }
 
 Status OccupancyMap::Rescale(double factor, Units units) {
@@ -175,7 +222,9 @@ Status OccupancyMap::Rescale(double factor, Units units) {
   const float f = static_cast<float>(factor);
   for (RayBatch& batch : batches_) {
     batch.origin *= factor;
-    for (Eigen::Vector3f& end : batch.ends) end *= f;
+    for (Eigen::Vector3f& end : batch.ends) {
+      end *= f;
+    }
   }
   units_ = units;
   if (units == Units::kMetres) {
@@ -185,7 +234,9 @@ Status OccupancyMap::Rescale(double factor, Units units) {
   } else if (tree_) {
     Rebuild(tree_->getResolution() * factor, max_range_ > 0.0 ? max_range_ * factor : max_range_);
   }
-  if (tree_) StoreBatch(RayBatch());  // the bound applies once the tree exists
+  if (tree_) {
+    StoreBatch(RayBatch());  // the bound applies once the tree exists
+  }
   ++revision_;
   return Status::Ok();
 }
@@ -196,11 +247,8 @@ Status OccupancyMap::Serialize(std::string* binary) const {
                          " of " + std::to_string(options_.min_rays_for_resolution) +
                          " rays needed to fix the voxel size of an up-to-scale map)");
   }
-  // writeBinary converts to maximum likelihood and prunes in place: do it on a copy.
-  octomap::OcTree copy(*tree_);
-  std::ostringstream out(std::ios::out | std::ios::binary);
-  if (!copy.writeBinary(out) || !out) return Status::Error("occupancy: writeBinary failed");
-  *binary = out.str();
+  binary->clear();
+  WriteOctreeBinary(*tree_, binary);
   return Status::Ok();
 }
 
@@ -210,42 +258,46 @@ Status OccupancyMap::SaveBt(const std::string& path) const {
   return WriteStringAtomically(path, binary).WithContext("occupancy: writing " + path);
 }
 
-int64_t OccupancyMap::NumOccupied() const {
-  if (!tree_) return 0;
-  if (num_occupied_cache_) return *num_occupied_cache_;
-  const unsigned max_depth = tree_->getTreeDepth();
-  int64_t count = 0;
-  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
-    if (tree_->isNodeOccupied(*it)) count += int64_t{1} << (3 * (max_depth - it.getDepth()));
-  }
-  num_occupied_cache_ = count;
-  return count;
-}
+int64_t OccupancyMap::NumOccupied() const { return tree_ ? num_occupied_ : 0; }
 
 std::optional<double> OccupancyMap::Occupancy(const Eigen::Vector3d& point_in_world) const {
-  if (!tree_ || !point_in_world.allFinite()) return std::nullopt;
+  if (!tree_ || !point_in_world.allFinite()) {
+    return std::nullopt;
+  }
   octomap::OcTreeKey key;
-  if (!tree_->coordToKeyChecked(ToOcto(point_in_world), key)) return std::nullopt;
+  if (!tree_->coordToKeyChecked(ToOcto(point_in_world), key)) {
+    return std::nullopt;
+  }
   const octomap::OcTreeNode* node = tree_->search(key);
-  if (!node) return std::nullopt;
+  if (!node) {
+    return std::nullopt;
+  }
   return node->getOccupancy();
 }
 
 bool OccupancyMap::IsOccupied(const Eigen::Vector3d& point_in_world) const {
-  if (!tree_ || !point_in_world.allFinite()) return false;
+  if (!tree_ || !point_in_world.allFinite()) {
+    return false;
+  }
   octomap::OcTreeKey key;
-  if (!tree_->coordToKeyChecked(ToOcto(point_in_world), key)) return false;
+  if (!tree_->coordToKeyChecked(ToOcto(point_in_world), key)) {
+    return false;
+  }
   const octomap::OcTreeNode* node = tree_->search(key);
   return node != nullptr && tree_->isNodeOccupied(node);
 }
 
 std::vector<Eigen::Vector3d> OccupancyMap::OccupiedVoxelCenters() const {
   std::vector<Eigen::Vector3d> centers;
-  if (!tree_) return centers;
+  if (!tree_) {
+    return centers;
+  }
   const double res = tree_->getResolution();
   const unsigned max_depth = tree_->getTreeDepth();
   for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
-    if (!tree_->isNodeOccupied(*it)) continue;
+    if (!tree_->isNodeOccupied(*it)) {
+      continue;
+    }
     const octomap::point3d c = it.getCoordinate();
     const Eigen::Vector3d center(c.x(), c.y(), c.z());
     const int n = 1 << (max_depth - it.getDepth());  // voxels per edge of this leaf

@@ -42,6 +42,7 @@
 
 namespace octomap {
 class OcTree;
+class KeyRay;
 }  // namespace octomap
 
 namespace mbslam {
@@ -158,22 +159,24 @@ class OccupancyMap {
   Status Rescale(double factor, Units units);
 
   // The tree as octomap::OcTree::writeBinary(std::ostream&) writes it (a header, then
-  // the maximum-likelihood tree, pruned): read it back with OcTree::readBinary. The map
-  // itself keeps its probabilities (the conversion runs on a copy).
+  // the maximum-likelihood tree, pruned), byte for byte: read it back with
+  // OcTree::readBinary. The map itself keeps its probabilities (writeBinary would
+  // convert it in place; this computes the same bytes from the const tree).
   Status Serialize(std::string* binary) const;
   // Writes the same bytes to a .bt file atomically (temporary file + rename): readable
   // with octomap::OcTree(path) and octovis.
   Status SaveBt(const std::string& path) const;
 
   // Occupied voxels at the finest resolution (a pruned leaf counts as all the voxels it
-  // covers) (count).
+  // covers) (count). Kept up to date by the updates: O(1).
   int64_t NumOccupied() const;
   // True when the voxel holding the point is known and occupied.
   bool IsOccupied(const Eigen::Vector3d& point_in_world) const;
   // Occupancy probability of the voxel holding the point; nullopt if unknown (never
   // observed) or outside the tree's range.
   std::optional<double> Occupancy(const Eigen::Vector3d& point_in_world) const;
-  // Centres of the occupied voxels at the finest resolution (for viewers and tests).
+  // Centres of the occupied voxels at the finest resolution (for viewers and tests):
+  // iterates over the whole tree.
   std::vector<Eigen::Vector3d> OccupiedVoxelCenters() const;
 
   // Voxel edge in map units; 0 while the resolution is not fixed yet.
@@ -198,7 +201,7 @@ class OccupancyMap {
   // The rays of one InsertRays call, kept for rebuilding.
   struct RayBatch {
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // camera centre (map units)
-    std::vector<Eigen::Vector3f> ends;                   // end points (map units)
+    std::vector<Eigen::Vector3f> ends;                 // end points (map units)
   };
 
   // Sets the voxel edge and range bound (map units) and rebuilds from the stored rays.
@@ -215,10 +218,13 @@ class OccupancyMap {
   std::unique_ptr<octomap::OcTree> tree_;
   double max_range_ = 0.0;
   std::deque<RayBatch> batches_;
+  int64_t num_occupied_ = 0;
+  // Scratch buffers of InsertBatch (OctoMap's KeyRay allocates 100k keys).
+  std::unique_ptr<octomap::KeyRay> key_ray_;
+  std::vector<uint64_t> updates_;
   int64_t stored_rays_ = 0;
   int64_t rays_forgotten_ = 0;
   int64_t revision_ = 0;
-  mutable std::optional<int64_t> num_occupied_cache_;
 };
 
 const char* OccupancyUnitsName(OccupancyMap::Units units);

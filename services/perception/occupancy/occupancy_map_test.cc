@@ -29,7 +29,7 @@ OccupancyMapOptions Metric(double resolution, double max_range) {
 // away from the voxel faces (multiples of 0.1) so that no test depends on rounding.
 std::vector<Eigen::Vector3d> WallPoints(double wall_x, double step) {
   std::vector<Eigen::Vector3d> points;
-  for (int i = 0; -0.987 + i * step <= 1.0; ++i) {
+  for (int i = 0; - 0.987 + i * step <= 1.0; ++i) {
     for (int j = 0; 0.013 + j * step <= 1.5; ++j) {
       points.emplace_back(wall_x, -0.987 + i * step, 0.013 + j * step);
     }
@@ -46,7 +46,9 @@ bool OccupiedNear(const OccupancyMap& map, const Eigen::Vector3d& p, double r) {
   for (int i = -1; i <= 1; ++i) {
     for (int j = -1; j <= 1; ++j) {
       for (int k = -1; k <= 1; ++k) {
-        if (map.IsOccupied(p + r * Eigen::Vector3d(i, j, k))) return true;
+        if (map.IsOccupied(p + r * Eigen::Vector3d(i, j, k))) {
+          return true;
+        }
       }
     }
   }
@@ -91,13 +93,53 @@ TEST(OccupancyMap, WallSeenFromSeveralViewpoints) {
     map.InsertRays(camera, WallPoints(4.02, 0.1));
   }
   // Every occupied voxel is on the wall, and every wall point is occupied.
-  for (const Eigen::Vector3d& c : map.OccupiedVoxelCenters()) EXPECT_NEAR(c.x(), 4.05, 1e-4);
-  for (const Eigen::Vector3d& p : WallPoints(4.02, 0.1)) EXPECT_TRUE(map.IsOccupied(p)) << p.transpose();
+  for (const Eigen::Vector3d& c : map.OccupiedVoxelCenters()) {
+    EXPECT_NEAR(c.x(), 4.05, 1e-4);
+  }
+  for (const Eigen::Vector3d& p : WallPoints(4.02, 0.1)) {
+    EXPECT_TRUE(map.IsOccupied(p)) << p.transpose();
+  }
   // The space between the cameras and the wall is free.
-  for (double x = 0.55; x < 3.8; x += 0.3) {
+  for (int i = 0; i < 11; ++i) {
+    const double x = 0.55 + 0.3 * i;
     const auto p = map.Occupancy(Eigen::Vector3d(x, 0.02, 0.83));
     ASSERT_TRUE(p.has_value()) << x;
     EXPECT_LT(*p, 0.5) << x;
+  }
+}
+
+TEST(OccupancyMap, SameTreeAsOctomapInsertPointCloud) {
+  for (const bool discretize : {false, true}) {
+    OccupancyMapOptions options = Metric(0.1, 6.0);
+    options.discretize = discretize;
+    OccupancyMap map(options, OccupancyMap::Units::kMetres);
+    octomap::OcTree reference(0.1);
+    for (int view = 0; view < 6; ++view) {
+      const Eigen::Vector3d camera(0.01 + 0.4 * view, 0.2 * view - 0.5, 0.81);
+      std::vector<Eigen::Vector3d> points = WallPoints(3.0 + 0.7 * view, 0.03);
+      for (const Eigen::Vector3d& p : WallPoints(9.0, 0.2)) {
+        points.push_back(p);  // beyond range
+      }
+      map.InsertRays(camera, points);
+      octomap::Pointcloud cloud;
+      for (const Eigen::Vector3d& p : points) {
+        cloud.push_back(p.x(), p.y(), p.z());
+      }
+      reference.insertPointCloud(cloud, octomap::point3d(camera.x(), camera.y(), camera.z()), 6.0,
+                                 false, discretize);
+    }
+    ASSERT_EQ(map.tree()->size(), reference.size()) << discretize;
+    std::ostringstream a, b;
+    map.tree()->writeBinaryConst(a);
+    reference.writeBinaryConst(b);
+    EXPECT_EQ(a.str(), b.str()) << discretize;
+    int64_t occupied = 0;
+    for (auto it = reference.begin_leafs(); it != reference.end_leafs(); ++it) {
+      if (reference.isNodeOccupied(*it)) {
+        occupied += int64_t{1} << (3 * (16 - it.getDepth()));
+      }
+    }
+    EXPECT_EQ(map.NumOccupied(), occupied) << discretize;
   }
 }
 
@@ -127,14 +169,13 @@ TEST(OccupancyMap, MaxRangeBoundsTheRay) {
 TEST(OccupancyMap, RejectsBadPoints) {
   OccupancyMap map(Metric(0.1, 0.0), OccupancyMap::Units::kMetres);  // unbounded range
   const Eigen::Vector3d camera(0.01, 0.02, 0.03);
-  const OccupancyInsertSummary s = map.InsertRays(
-      camera, {Eigen::Vector3d(NAN, 0, 0), camera, Eigen::Vector3d(1e9, 0, 0),
-               Eigen::Vector3d(2.0, 0.02, 0.03)});
+  const OccupancyInsertSummary s =
+      map.InsertRays(camera, {Eigen::Vector3d(NAN, 0, 0), camera, Eigen::Vector3d(1e9, 0, 0),
+                              Eigen::Vector3d(2.0, 0.02, 0.03)});
   EXPECT_EQ(s.rays_rejected, 3);
   EXPECT_EQ(s.rays_inserted, 1);
-  EXPECT_EQ(map.InsertRays(Eigen::Vector3d(INFINITY, 0, 0), {Eigen::Vector3d(1, 0, 0)})
-                .rays_rejected,
-            1);
+  EXPECT_EQ(
+      map.InsertRays(Eigen::Vector3d(INFINITY, 0, 0), {Eigen::Vector3d(1, 0, 0)}).rays_rejected, 1);
   EXPECT_EQ(map.NumOccupied(), 1);
   EXPECT_LT(map.max_range(), 0.0);
   EXPECT_FALSE(map.IsOccupied(Eigen::Vector3d(NAN, 0, 0)));
@@ -163,7 +204,9 @@ TEST(OccupancyMap, SerializeRoundTripsThroughReadBinary) {
   EXPECT_DOUBLE_EQ(read.getResolution(), 0.1);
   int64_t occupied = 0;
   for (auto it = read.begin_leafs(); it != read.end_leafs(); ++it) {
-    if (read.isNodeOccupied(*it)) occupied += int64_t{1} << (3 * (16 - it.getDepth()));
+    if (read.isNodeOccupied(*it)) {
+      occupied += int64_t{1} << (3 * (16 - it.getDepth()));
+    }
   }
   EXPECT_EQ(occupied, map.NumOccupied());
   EXPECT_GT(occupied, 100);
@@ -173,7 +216,8 @@ TEST(OccupancyMap, SerializeRoundTripsThroughReadBinary) {
     EXPECT_TRUE(read.isNodeOccupied(node));
   }
   const Eigen::Vector3d free_point(1.05, 0.35, 0.55);
-  const octomap::OcTreeNode* free_node = read.search(free_point.x(), free_point.y(), free_point.z());
+  const octomap::OcTreeNode* free_node =
+      read.search(free_point.x(), free_point.y(), free_point.z());
   ASSERT_NE(free_node, nullptr);
   EXPECT_FALSE(read.isNodeOccupied(free_node));
   // Serialising did not turn the map itself into its maximum-likelihood version (which
@@ -229,7 +273,9 @@ TEST(OccupancyMap, RescaleKeepsTheGeometry) {
   EXPECT_NEAR(map.resolution(), 0.2, 1e-12);
   EXPECT_NEAR(map.max_range(), 40.0, 1e-12);
   EXPECT_EQ(map.NumOccupied(), occupied);
-  for (const Eigen::Vector3d& c : before) EXPECT_TRUE(map.IsOccupied(2.0 * c)) << c.transpose();
+  for (const Eigen::Vector3d& c : before) {
+    EXPECT_TRUE(map.IsOccupied(2.0 * c)) << c.transpose();
+  }
   EXPECT_LT(*map.Occupancy(Eigen::Vector3d(2.0, 0.4, 1.0)), 0.5);
 
   // To metres: voxel edge and range bound from the options, geometry kept to a voxel.
@@ -240,7 +286,9 @@ TEST(OccupancyMap, RescaleKeepsTheGeometry) {
   for (const Eigen::Vector3d& c : before) {
     EXPECT_TRUE(OccupiedNear(map, 1.5 * c, 0.1)) << c.transpose();
   }
-  for (const Eigen::Vector3d& c : map.OccupiedVoxelCenters()) EXPECT_NEAR(c.x(), 1.5 * 3.03, 0.1);
+  for (const Eigen::Vector3d& c : map.OccupiedVoxelCenters()) {
+    EXPECT_NEAR(c.x(), 1.5 * 3.03, 0.1);
+  }
 
   EXPECT_FALSE(map.Rescale(0.0, OccupancyMap::Units::kMetres).ok());
   EXPECT_FALSE(map.Rescale(NAN, OccupancyMap::Units::kMetres).ok());
@@ -257,8 +305,12 @@ TEST(OccupancyMap, UpToScaleResolutionFromMedianDepth) {
   EXPECT_FALSE(map.IsResolutionFixed());
   // 60 rays of length 10 and 50 of length 30: median 10 once 100 have arrived.
   std::vector<Eigen::Vector3d> near, far;
-  for (int i = 0; i < 60; ++i) near.emplace_back(10.0, 0.001 * i, 0.0);
-  for (int i = 0; i < 50; ++i) far.emplace_back(30.0, 0.001 * i, 0.0);
+  for (int i = 0; i < 60; ++i) {
+    near.emplace_back(10.0, 0.001 * i, 0.0);
+  }
+  for (int i = 0; i < 50; ++i) {
+    far.emplace_back(30.0, 0.001 * i, 0.0);
+  }
   const Eigen::Vector3d camera = Eigen::Vector3d::Zero();
   OccupancyInsertSummary s = map.InsertRays(camera, near);
   EXPECT_EQ(s.rays_buffered, 60);
@@ -301,8 +353,12 @@ TEST(OccupancyMap, StoredRaysAreBounded) {
   options.max_stored_rays = 250;
   OccupancyMap map(options, OccupancyMap::Units::kMetres);
   std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < 100; ++i) points.emplace_back(3.0, 0.05 * i, 0.0);
-  for (int k = 0; k < 3; ++k) map.InsertRays(Eigen::Vector3d(0.0, 0.0, 0.1 * k), points);
+  for (int i = 0; i < 100; ++i) {
+    points.emplace_back(3.0, 0.05 * i, 0.0);
+  }
+  for (int k = 0; k < 3; ++k) {
+    map.InsertRays(Eigen::Vector3d(0.0, 0.0, 0.1 * k), points);
+  }
   EXPECT_EQ(map.num_stored_rays(), 200);
   EXPECT_EQ(map.rays_forgotten(), 100);
 
@@ -323,9 +379,9 @@ TEST(OccupancyMapOptions, CheckAndYaml) {
   EXPECT_FALSE(options.Check());
 
   OccupancyMapOptions loaded;
-  ASSERT_TRUE(LoadOptionsFromYamlText("resolution_m: 0.05\nmax_range_m: 8\ndiscretize: true\n",
-                                      "", &loaded)
-                  .ok());
+  ASSERT_TRUE(
+      LoadOptionsFromYamlText("resolution_m: 0.05\nmax_range_m: 8\ndiscretize: true\n", "", &loaded)
+          .ok());
   EXPECT_DOUBLE_EQ(loaded.resolution_m, 0.05);
   EXPECT_DOUBLE_EQ(loaded.max_range_m, 8.0);
   EXPECT_TRUE(loaded.discretize);

@@ -191,8 +191,11 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     o.body_id = options_.slam.use_segmentation ? t.body_id : 0;
     o.p_static = options_.slam.use_segmentation ? t.p_static : 1.0;
     o.is_new = t.is_new;
+    o.patch = t.patch;
     slam_frame.observations.push_back(o);
   }
+  slam_frame.image = frame.gray;
+  slam_frame.intrinsics = frame.intrinsics.get();
   for (const TrackingHints::Hull& h : occluders_) {
     std::vector<Eigen::Vector2f> xy;
     for (const Eigen::Vector2f& p : h.points) xy.push_back(intrinsics.PixelToNormalized(p.cast<double>()).cast<float>());
@@ -202,6 +205,19 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   {
     ScopedStageTimer timer(slam_timer_);
     slam_pose = slam_.TrackPose(slam_frame);
+    // Re-found map points become tracks again (they rejoin the segmentation as static).
+    for (const auto& [point_id, uv] : slam_pose.refound) {
+      const int64_t track_id = tracker_.AdoptTrack(uv, 0);
+      if (track_id < 0) continue;
+      slam_.AssociateTrack(point_id, track_id);
+      SlamObservation o;
+      o.track_id = track_id;
+      o.uv = uv.cast<double>();
+      o.xy = intrinsics.PixelToNormalized(o.uv);
+      o.body_id = 0;
+      o.p_static = 0.9;
+      slam_frame.observations.push_back(o);
+    }
   }
 
   // Segmentation on the active tracks.

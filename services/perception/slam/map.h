@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
 
 #include "common/util/status.h"
 #include "services/perception/geometry/rigid3.h"
@@ -33,6 +34,7 @@ struct MapPoint {
   int times_found = 0;              // frames it was matched
   bool occluded = false;            // behind a moving object (sec. 4.3): kept, not matched
   uint8_t gray = 128;               // intensity at creation (for display)
+  cv::Mat patch;                    // appearance at the last observation (guided matching)
 };
 
 struct Keyframe {

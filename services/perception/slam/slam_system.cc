@@ -11,6 +11,7 @@
 #include "common/util/logging.h"
 #include "services/perception/geometry/polygon.h"
 #include "services/perception/slam/triangulation.h"
+#include "services/perception/tracking/patch_matcher.h"
 
 namespace mbslam {
 namespace {
@@ -55,6 +56,7 @@ void SlamSystem::Flush() { MergeBundleAdjustment(/*wait=*/true); }
 
 void SlamSystem::Reset() {
   Flush();
+  bridge_.reset();
   map_.Clear();
   state_ = SlamState::kNotInitialized;
   init_ref_frame_ = -1;
@@ -101,6 +103,39 @@ std::optional<Rigid3d> SlamSystem::PoseOf(int64_t frame) const {
   return it->second.cam_from_world;
 }
 
+void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
+                                     std::vector<int64_t>* point_ids, std::vector<Eigen::Vector2d>* xy,
+                                     std::vector<Eigen::Vector2f>* uv) {
+  const CameraIntrinsics& K = *frame.intrinsics;
+  std::set<int64_t> candidates;
+  int kfs = 0;
+  for (auto it = map_.keyframes().rbegin(); it != map_.keyframes().rend() && kfs < options_.guided_keyframes;
+       ++it, ++kfs) {
+    candidates.insert(it->second.point_ids.begin(), it->second.point_ids.end());
+  }
+  const int margin = options_.guided_radius_px + 8;
+  int searched = 0;
+  for (int64_t pid : candidates) {
+    if (searched >= options_.guided_max_points) break;
+    const MapPoint* p = map_.point(pid);
+    if (!p || p->track_id >= 0 || p->occluded || p->patch.empty()) continue;
+    const Eigen::Vector3d pc = T * p->position;
+    if (pc.z() <= 1e-6) continue;
+    const Eigen::Vector2d pred = K.Project(pc);
+    if (!K.InImage(pred, margin)) continue;
+    ++searched;
+    const PatchMatch m = FindPatchZssd(frame.image, p->patch, pred.cast<float>(), options_.guided_radius_px);
+    if (!m.found) continue;
+    cv::Mat found;
+    if (!ExtractPatch(frame.image, m.uv, p->patch.cols, &found) || PatchNcc(found, p->patch) < options_.guided_min_ncc) {
+      continue;
+    }
+    point_ids->push_back(pid);
+    uv->push_back(m.uv);
+    xy->push_back(K.PixelToNormalized(m.uv.cast<double>()));
+  }
+}
+
 std::optional<Rigid3d> SlamSystem::PredictPose(const SlamFrame& frame) const {
   if (recent_poses_.empty()) return std::nullopt;
   auto last = recent_poses_.rbegin();
@@ -139,6 +174,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   std::vector<Eigen::Vector3d> X;
   std::vector<Eigen::Vector2d> xy;
   std::vector<int64_t> tracks;
+  std::vector<cv::Mat> patches;
   for (const SlamObservation& o : frame.observations) {
     if (o.body_id != 0) continue;  // only tracks segmentation holds static
     const int64_t pid = map_.PointOfTrack(o.track_id);
@@ -147,22 +183,43 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     X.push_back(p->position);
     xy.push_back(o.xy);
     tracks.push_back(o.track_id);
+    patches.push_back(o.patch);
+  }
+  const std::optional<Rigid3d> prior = PredictPose(frame);
+  // Stage 2 (guided matching): points that lost their tracks are searched around their
+  // projection from the predicted pose, then everything is resected together.
+  std::vector<int64_t> refound_ids;
+  std::vector<Eigen::Vector2f> refound_uv;
+  if (options_.guided_matching && prior && frame.intrinsics && !frame.image.empty()) {
+    std::vector<Eigen::Vector2d> gxy;
+    FindUntrackedPoints(frame, *prior, &refound_ids, &gxy, &refound_uv);
+    for (size_t i = 0; i < refound_ids.size(); ++i) {
+      X.push_back(map_.point(refound_ids[i])->position);
+      xy.push_back(gxy[i]);
+      tracks.push_back(-1 - static_cast<int64_t>(i));  // marks a re-found point
+      patches.emplace_back();
+    }
   }
   out.num_correspondences = static_cast<int>(X.size());
-  const std::optional<Rigid3d> prior = PredictPose(frame);
   PoseEstimate est;
   if (X.size() >= 6) est = EstimatePose(X, xy, frame.focal_px, prior, options_.pose);
   const bool good = est.ok && est.num_inliers >= options_.min_tracking_inliers;
+  MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": correspondences " << X.size() << " (re-found "
+                    << refound_ids.size() << "), inliers " << est.num_inliers << ", rms " << est.rms_px
+                    << " px, points " << map_.num_points() << ", keyframes " << map_.num_keyframes();
   if (good && state_ == SlamState::kConfirming) {
     const double ratio = static_cast<double>(est.num_inliers) / static_cast<double>(X.size());
     if (ratio < options_.init_confirm_inlier_ratio) {
       MBSLAM_LOG(INFO) << "SLAM: new map not confirmed (inlier share " << ratio << "); retrying";
+      const std::optional<Bridge> keep = bridge_;
       Reset();
+      bridge_ = keep;
       out.state = state_;
       return out;
     }
     if (++confirm_count_ >= options_.init_confirm_frames) {
       state_ = SlamState::kTracking;
+      bridge_.reset();
       out.relocalized = just_initialized_;
       MBSLAM_LOG(INFO) << "SLAM: map confirmed (" << map_.num_points() << " points)";
     }
@@ -175,8 +232,17 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     out.covariance = est.covariance;
     out.num_inliers = est.num_inliers;
     last_inliers_ = est.num_inliers;
+    out.num_refound = 0;
     StorePose(frame.frame_index, est.cam_from_world, est.covariance);
     for (size_t i = 0; i < tracks.size(); ++i) {
+      if (tracks[i] < 0) {  // re-found by guided matching
+        const size_t k = static_cast<size_t>(-1 - tracks[i]);
+        if (est.inliers[i]) {
+          out.refound.emplace_back(refound_ids[k], refound_uv[k]);
+          if (MapPoint* p = map_.point(refound_ids[k])) p->last_seen_frame = frame.frame_index;
+        }
+        continue;
+      }
       const int64_t pid = map_.PointOfTrack(tracks[i]);
       MapPoint* p = map_.point(pid);
       if (!p) continue;
@@ -185,6 +251,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
         ++p->times_found;
         p->last_seen_frame = frame.frame_index;
         p->occluded = false;
+        if (!patches[i].empty()) p->patch = patches[i];
       } else {
         map_.ReleaseTrack(tracks[i]);  // the track drifted off its point
       }
@@ -192,12 +259,27 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   } else {
     ++lost_frames_;
     if (state_ == SlamState::kConfirming) {
+      const std::optional<Bridge> keep = bridge_;
       Reset();
+      bridge_ = keep;
     } else {
       state_ = SlamState::kLost;
       if (lost_frames_ >= options_.lost_frames_to_reinit) {
         MBSLAM_LOG(WARNING) << "SLAM: lost for " << lost_frames_ << " frames; re-initialising";
+        std::optional<Bridge> bridge;
+        if (recent_poses_.size() >= 2) {
+          auto last = recent_poses_.rbegin();
+          auto prev = std::next(last);
+          Bridge b;
+          b.frame = last->first;
+          b.cam_from_world = *PoseOf(last->first);
+          b.twist_per_frame = (b.cam_from_world * PoseOf(prev->first)->Inverse()).Log() /
+                              static_cast<double>(last->first - prev->first);
+          b.metric = metric_;
+          bridge = b;
+        }
         Reset();
+        bridge_ = bridge;
         just_initialized_ = true;
       }
     }
@@ -388,11 +470,12 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   const BaSummary s = SolveBa(&problem, options_.ba);
   if (s.usable) ApplyBaResult(problem, options_.ba, &map_);
   ++ba_runs_;
+  if (bridge_) ApplyBridge(init_ref_frame_, frame.frame_index);
   const Keyframe& kf1 = *map_.keyframe(id1);
   // Covariances of the two views: small (a few hundredths of a pixel-equivalent).
   const Matrix6d init_cov = Matrix6d::Identity() * std::pow(0.5 / frame.focal_px, 2);
   FramePose p0;
-  p0.cam_from_world = Rigid3d();
+  p0.cam_from_world = map_.keyframe(id0)->cam_from_world;
   p0.covariance = init_cov;
   p0.anchor_keyframe = id0;
   recent_poses_[init_ref_frame_] = p0;
@@ -416,6 +499,35 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   out->num_inliers = static_cast<int>(map_.num_points());
   out->metric = metric_;
   out->scale_to_metric = metric_ ? 1.0 : 0.0;
+}
+
+void SlamSystem::ApplyBridge(int64_t ref_frame, int64_t cur_frame) {
+  // Kept until the new map is confirmed (an unconfirmed map is dropped and the next
+  // attempt needs the bridge again).
+  const Bridge b = *bridge_;
+  // The reference view's pose in the old world frame, carried over the gap.
+  const Rigid3d ref_in_old = Rigid3d::Exp(b.twist_per_frame * static_cast<double>(ref_frame - b.frame)) * b.cam_from_world;
+  // Units: metric maps are already comparable; otherwise the new baseline takes the
+  // length the old velocity predicts for it.
+  double scale = 1.0;
+  const Keyframe* k1 = map_.LastKeyframe();
+  if (!(b.metric && metric_) && k1 != nullptr) {
+    const double predicted = Rigid3d::Exp(b.twist_per_frame).translation.norm() * static_cast<double>(cur_frame - ref_frame);
+    const double measured = k1->cam_from_world.translation.norm();
+    if (predicted > 1e-9 && measured > 1e-9) scale = predicted / measured;
+    metric_ = b.metric;
+  }
+  // X_old = ref_in_old^-1 * (scale * X_new): the new world frame is the reference camera.
+  const Rigid3d old_from_new = ref_in_old.Inverse();
+  map_.Rescale(scale);
+  for (auto& [id, k] : map_.keyframes()) k.cam_from_world = k.cam_from_world * old_from_new.Inverse();
+  for (auto& [id, p] : map_.points()) p.position = old_from_new * p.position;
+  for (auto& [frame, pose] : recent_poses_) {
+    pose.cam_from_world.translation *= scale;
+    pose.cam_from_world = pose.cam_from_world * old_from_new.Inverse();
+  }
+  MBSLAM_LOG(INFO) << "SLAM: new map continues the previous world frame (gap of " << ref_frame - b.frame
+                   << " frames, scale x" << scale << ")";
 }
 
 bool SlamSystem::NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const {

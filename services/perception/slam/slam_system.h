@@ -26,8 +26,10 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
 
 #include "common/config/options.h"
+#include "services/perception/geometry/camera.h"
 #include "common/util/status.h"
 #include "services/perception/geometry/rigid3.h"
 #include "services/perception/segmentation/relative_motion.h"
@@ -64,6 +66,11 @@ struct SlamOptions {
   bool use_segmentation = true;          // feedback from segmentation: moving tracks never enter the map (false = ablation)
   double depth_bound_margin = 0.15;      // known-depth bound: depth * (1 +- margin)
   double frustum_bound_factor = 2.0;     // frustum bound: [min / f, max * f] of map depths around the ray
+  bool guided_matching = true;           // re-find untracked map points around their projection (ch. 2 stage 2)
+  int guided_keyframes = 5;              // map points of this many recent keyframes are searched (count)
+  int guided_radius_px = 10;             // search half-window around the predicted projection (px)
+  double guided_min_ncc = 0.8;           // acceptance (normalised cross-correlation)
+  int guided_max_points = 400;           // at most this many searches per image (count)
   std::string map_load_path;             // map loaded at start ("" = none)
   std::string map_save_path;             // map saved at exit ("" = none)
 
@@ -118,6 +125,11 @@ struct SlamOptions {
     v("use_segmentation", &use_segmentation, "segmentation feedback: moving tracks stay out of the map (false = ablation)");
     v("depth_bound_margin", &depth_bound_margin, "known-depth bound: depth * (1 +- margin)");
     v("frustum_bound_factor", &frustum_bound_factor, "frustum depth bound: [min / f, max * f]");
+    v("guided_matching", &guided_matching, "re-find untracked map points around their projection");
+    v("guided_keyframes", &guided_keyframes, "recent keyframes whose points are searched (count)");
+    v("guided_radius_px", &guided_radius_px, "guided search half-window (px)");
+    v("guided_min_ncc", &guided_min_ncc, "guided match acceptance (NCC)");
+    v("guided_max_points", &guided_max_points, "guided searches per image at most (count)");
     v("map_load_path", &map_load_path, "map loaded at start (\"\" = none)");
     v("map_save_path", &map_save_path, "map saved at exit (\"\" = none)");
   }
@@ -130,6 +142,7 @@ struct SlamObservation {
   int body_id = -1;        // label from the previous segmentation (0 static)
   double p_static = 0.5;   // segmentation's P(static) for the track
   bool is_new = false;
+  cv::Mat patch;           // the track's current appearance (shallow copy), kept by its map point
 };
 
 struct SlamFrame {
@@ -140,6 +153,8 @@ struct SlamFrame {
   std::optional<Rigid3d> odom_from_cam;                // interpolated odometry (metric), if any
   std::vector<std::vector<Eigen::Vector2f>> moving_hulls_xy;  // moving objects' hulls (normalised coordinates)
   uint8_t mean_gray = 128;
+  cv::Mat image;                                       // gray image (level 0), for guided matching
+  const CameraIntrinsics* intrinsics = nullptr;        // projection into pixels
 };
 
 enum class SlamState { kNotInitialized, kInitializing, kConfirming, kTracking, kLost };
@@ -154,6 +169,10 @@ struct SlamPose {
   int num_correspondences = 0;
   bool metric = false;                     // map in metres (odometry)
   double scale_to_metric = 0.0;
+  // Map points without a track that guided matching found again in this image (pixels):
+  // the tracker adopts them as tracks and hands the ids back (AssociateTrack).
+  std::vector<std::pair<int64_t, Eigen::Vector2f>> refound;
+  int num_refound = 0;
 };
 
 
@@ -185,6 +204,9 @@ class SlamSystem {
   // range of the map around its ray (the frustum), else [0, inf).
   DepthBound DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const;
 
+  // Links a re-found map point to the track the tracker created for it.
+  void AssociateTrack(int64_t point_id, int64_t track_id) { map_.AssociateTrack(point_id, track_id); }
+
   // Waits for the back-end, e.g. before reading the map or at the end of a replay.
   void Flush();
   void Reset();
@@ -212,6 +234,10 @@ class SlamSystem {
   // with odometry are far enough apart.
   std::optional<double> EstablishMetricScale();
   std::optional<Rigid3d> PredictPose(const SlamFrame& frame) const;
+  // Guided matching: untracked points of the recent keyframes near their projection.
+  void FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& cam_from_world,
+                           std::vector<int64_t>* point_ids, std::vector<Eigen::Vector2d>* xy,
+                           std::vector<Eigen::Vector2f>* uv);
 
   const SlamOptions options_;
   Map map_;
@@ -246,6 +272,18 @@ class SlamSystem {
   int last_inliers_ = 0;
   bool metric_ = false;
   bool just_initialized_ = false;
+
+  // After a loss the next map continues the previous world frame: the pose is carried
+  // over the gap with the last velocity, and (without metric scale) the units follow
+  // from the last speed. Set when a lost map is dropped, used by the next initialisation.
+  struct Bridge {
+    int64_t frame = 0;            // last good frame
+    Rigid3d cam_from_world;       // its pose (old world frame)
+    Vector6d twist_per_frame = Vector6d::Zero();  // cam motion per frame (left, old units)
+    bool metric = false;
+  };
+  std::optional<Bridge> bridge_;
+  void ApplyBridge(int64_t ref_frame, int64_t cur_frame);
 
   // Frustum depth grids per reference frame, rebuilt every image (the map changes).
   struct DepthGrid {

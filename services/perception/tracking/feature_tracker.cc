@@ -229,6 +229,29 @@ int FeatureTracker::GuidedMatch(const std::unordered_map<int64_t, Eigen::Vector2
   return found;
 }
 
+int64_t FeatureTracker::AdoptTrack(const Eigen::Vector2f& uv, int body_id) {
+  if (prev_pyramid_.empty()) return -1;
+  const cv::Mat& image = prev_pyramid_[0];
+  if (!InBorder(uv, image, static_cast<float>(options_.border_px))) return -1;
+  const float r2 = static_cast<float>(options_.unicity_px * options_.unicity_px);
+  for (const Track& t : tracks_) {
+    if ((t.uv - uv).squaredNorm() < std::max(r2, 1.0f)) return -1;
+  }
+  Track t;
+  t.id = next_id_++;
+  t.uv = uv;
+  t.first_frame = frame_index_;
+  t.last_seen_frame = frame_index_;
+  t.body_id = body_id;
+  t.p_static = body_id == 0 ? 0.9f : 0.5f;
+  t.age = 2;  // established: it continues a known point
+  t.is_new = false;
+  if (!ExtractPatch(image, t.uv, options_.patch_size, &t.patch)) return -1;
+  t.anchor = t.patch;
+  tracks_.push_back(std::move(t));
+  return tracks_.back().id;
+}
+
 void FeatureTracker::EnforceUnicity() {
   if (options_.unicity_px <= 0.0) return;
   const float cell = static_cast<float>(std::max(1.0, options_.unicity_px));

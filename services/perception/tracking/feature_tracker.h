@@ -127,6 +127,11 @@ class FeatureTracker {
   // given predicted positions (ZSSD on the stored template). Returns the number found.
   int GuidedMatch(const std::unordered_map<int64_t, Eigen::Vector2f>& predicted_uv);
 
+  // Starts a track at a position found by other means (guided matching of a map point)
+  // in the latest image; returns its id, or -1 if it is too close to an existing track
+  // or to the border.
+  int64_t AdoptTrack(const Eigen::Vector2f& uv, int body_id);
+
   std::vector<Track>& tracks() { return tracks_; }
   const std::vector<Track>& tracks() const { return tracks_; }
   const TrackerStats& stats() const { return stats_; }

@@ -1,0 +1,49 @@
+#ifndef MBSLAM_SERVICES_PERCEPTION_OCCUPANCY_OCTREE_OPS_H_
+#define MBSLAM_SERVICES_PERCEPTION_OCCUPANCY_OCTREE_OPS_H_
+
+// Two faster equivalents of OctoMap operations, used by OccupancyMap:
+//
+// * ApplyVoxelUpdates: the update step of OcTree::insertPointCloud (each voxel once per
+//   scan, occupied before free), giving the same tree node for node, but walking the
+//   tree once in depth-first (Morton) order instead of descending from the root for
+//   every voxel. A keyframe's rays touch ~40k voxels at 10 cm; this is what keeps the
+//   update within its budget (bench/occupancy_bench.cc).
+// * WriteOctreeBinary: the bytes OcTree::writeBinary(std::ostream&) writes (maximum
+//   likelihood, pruned), computed from a const tree without copying or modifying it.
+//
+// Both rely only on OctoMap's public node API and binary format (OctoMap 1.9); the
+// tests compare them byte for byte with OctoMap's own functions.
+
+#include <octomap/OcTree.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mbslam {
+
+// Interleaves the bits of a key so that bits 3l, 3l+1, 3l+2 are bit l of key[0],
+// key[1], key[2]: the child index at each level, so sorted codes visit the tree in
+// depth-first order.
+uint64_t OctreeMortonCode(const octomap::OcTreeKey& key);
+octomap::OcTreeKey OctreeKeyOfMortonCode(uint64_t code);
+
+// One voxel update for ApplyVoxelUpdates: OctreeMortonCode(key) << 1 | (1 if hit).
+inline uint64_t VoxelUpdate(const octomap::OcTreeKey& key, bool hit) {
+  return OctreeMortonCode(key) << 1 | (hit ? 1u : 0u);
+}
+
+// Applies one scan's voxel updates at the finest depth: every voxel listed is updated
+// once, with the hit log-odds if any of its entries is a hit, else with the miss
+// log-odds (OctoMap's insertPointCloud semantics, non-lazy: inner nodes are updated and
+// pruned). Sorts `updates` in place. Returns the change in the number of occupied
+// voxels at the finest resolution.
+int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates);
+
+// Appends to `out` exactly what `octomap::OcTree copy(tree); copy.writeBinary(stream)`
+// would write.
+void WriteOctreeBinary(const octomap::OcTree& tree, std::string* out);
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_SERVICES_PERCEPTION_OCCUPANCY_OCTREE_OPS_H_
