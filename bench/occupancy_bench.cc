@@ -1,0 +1,147 @@
+// Occupancy map costs (thesis sec. 6.3; issue target: <= 20 ms per keyframe for
+// 100-300 new points with ranges up to ~20 m, one core).
+//
+//   build/bin/occupancy_bench [--benchmark_filter=InsertRays]
+//
+// The scene: a camera walking along a street (x forward, 0.5 m between keyframes) sees
+// new static points on the facades left and right and on the ground, 1 to 20 m away,
+// mostly ahead. The map is warmed up with 60 keyframes before timing, then keeps growing
+// as in a run.
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "services/perception/occupancy/occupancy_map.h"
+
+namespace {
+
+using mbslam::OccupancyMap;
+using mbslam::OccupancyMapOptions;
+
+struct Keyframe {
+  Eigen::Vector3d camera;
+  std::vector<Eigen::Vector3d> points;
+};
+
+// Keyframe k: the camera at x = 0.5 k, 1.6 m high; points on two facades (y = +-6 m)
+// and the ground (z = 0), at distances up to max_range_m, uniform in distance.
+Keyframe MakeKeyframe(int k, int num_points, double max_range_m, std::mt19937* rng) {
+  Keyframe kf;
+  kf.camera = Eigen::Vector3d(0.5 * k, 0.0, 1.6);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  kf.points.reserve(static_cast<size_t>(num_points));
+  while (static_cast<int>(kf.points.size()) < num_points) {
+    const double range = 1.0 + (max_range_m - 1.0) * uni(*rng);
+    const double azimuth = (uni(*rng) - 0.5) * 1.6;  // within about +-45 deg of x
+    const double surface = uni(*rng);
+    Eigen::Vector3d p;
+    if (surface < 0.7) {  // facade: the side the azimuth points to
+      const double y = azimuth >= 0.0 ? 6.0 : -6.0;
+      const double x_offset = std::sqrt(std::max(0.0, range * range - 36.0));
+      p = Eigen::Vector3d(kf.camera.x() + x_offset, y, 0.2 + 7.0 * uni(*rng));
+    } else {  // ground
+      const double horizontal = std::sqrt(std::max(0.0, range * range - 1.6 * 1.6));
+      p = Eigen::Vector3d(kf.camera.x() + horizontal * std::cos(azimuth),
+                          horizontal * std::sin(azimuth), 0.0);
+    }
+    if ((p - kf.camera).norm() <= max_range_m) {
+      kf.points.push_back(p);
+    }
+  }
+  return kf;
+}
+
+OccupancyMapOptions Options(double resolution_m) {
+  OccupancyMapOptions options;
+  options.resolution_m = resolution_m;
+  options.max_range_m = 20.0;
+  return options;
+}
+
+// Args: points per keyframe, voxel edge (cm).
+void BM_InsertRaysPerKeyframe(benchmark::State& state) {
+  const int num_points = static_cast<int>(state.range(0));
+  const double resolution = 0.01 * static_cast<double>(state.range(1));
+  OccupancyMap map(Options(resolution), OccupancyMap::Units::kMetres);
+  std::mt19937 rng(7);
+  int k = 0;
+  for (; k < 60; ++k) {
+    const Keyframe kf = MakeKeyframe(k, num_points, 20.0, &rng);
+    map.InsertRays(kf.camera, kf.points);
+  }
+  // Keyframes prepared outside the timed region, a fresh one per iteration.
+  std::vector<Keyframe> pending;
+  for (auto _ : state) {
+    state.PauseTiming();
+    if (pending.empty()) {
+      for (int i = 0; i < 64; ++i) {
+        pending.push_back(MakeKeyframe(k++, num_points, 20.0, &rng));
+      }
+      std::reverse(pending.begin(), pending.end());
+    }
+    const Keyframe kf = std::move(pending.back());
+    pending.pop_back();
+    state.ResumeTiming();
+    const mbslam::OccupancyInsertSummary s = map.InsertRays(kf.camera, kf.points);
+    benchmark::DoNotOptimize(s.rays_inserted);
+  }
+  state.counters["points"] = num_points;
+  state.counters["resolution_m"] = resolution;
+  state.counters["occupied_voxels"] = static_cast<double>(map.NumOccupied());
+}
+BENCHMARK(BM_InsertRaysPerKeyframe)
+    ->ArgsProduct({{100, 200, 300}, {10, 5}})
+    ->Unit(benchmark::kMillisecond);
+
+// A map of 200 keyframes x 300 points: what publishing PERCEPTION_OCCUPANCY costs.
+void BM_Serialize(benchmark::State& state) {
+  const double resolution = 0.01 * static_cast<double>(state.range(0));
+  OccupancyMap map(Options(resolution), OccupancyMap::Units::kMetres);
+  std::mt19937 rng(11);
+  for (int k = 0; k < 200; ++k) {
+    const Keyframe kf = MakeKeyframe(k, 300, 20.0, &rng);
+    map.InsertRays(kf.camera, kf.points);
+  }
+  std::string binary;
+  for (auto _ : state) {
+    if (!map.Serialize(&binary).ok()) {
+      state.SkipWithError("Serialize failed");
+    }
+    benchmark::DoNotOptimize(binary.data());
+  }
+  state.counters["bytes"] = static_cast<double>(binary.size());
+  state.counters["occupied_voxels"] = static_cast<double>(map.NumOccupied());
+}
+BENCHMARK(BM_Serialize)->Arg(10)->Arg(5)->Unit(benchmark::kMillisecond);
+
+// The one-off rebuild when the map switches to metres: 200 keyframes x 300 rays.
+void BM_RescaleRebuild(benchmark::State& state) {
+  OccupancyMapOptions options = Options(0.1);
+  options.resolution_depth_fraction = 0.0;
+  OccupancyMap map(options, OccupancyMap::Units::kUpToScale);
+  std::mt19937 rng(13);
+  for (int k = 0; k < 200; ++k) {
+    const Keyframe kf = MakeKeyframe(k, 300, 20.0, &rng);
+    map.InsertRays(kf.camera, kf.points);
+  }
+  double factor = 1.01;
+  for (auto _ : state) {
+    if (!map.Rescale(factor, OccupancyMap::Units::kUpToScale).ok()) {
+      state.SkipWithError("Rescale failed");
+    }
+    factor = 1.0 / factor;
+  }
+  state.counters["rays"] = static_cast<double>(map.num_stored_rays());
+}
+BENCHMARK(BM_RescaleRebuild)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+
+BENCHMARK_MAIN();
