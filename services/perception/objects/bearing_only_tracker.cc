@@ -276,8 +276,10 @@ void BearingOnlyTracker::RebaseGroundHeights(const std::optional<GroundPlane>& p
   plane_ = plane;
 }
 
-void BearingOnlyTracker::Propagate(double dt, const StepCues& c, std::vector<char>* violated) {
-  violated->assign(particles_.size(), 0);
+void BearingOnlyTracker::Propagate(double dt, const StepCues& c,
+                                   std::vector<double>* truncation_log_weight) {
+  truncation_log_weight->assign(particles_.size(), 0.0);
+  const double log_violation = std::log(options_.violation_weight);
   const double sq = std::sqrt(std::max(dt, 0.0));
   const double sv = options_.accel_sigma * sq;
   const double sw = options_.angular_accel_sigma * sq;
@@ -290,7 +292,9 @@ void BearingOnlyTracker::Propagate(double dt, const StepCues& c, std::vector<cha
     const BotParticle& prior = particles_[i];
     BotParticle candidate = prior;
     bool ok = false;
-    for (int attempt = 0; attempt < options_.max_rejection_tries && !ok; ++attempt) {
+    int attempts = 0;
+    while (!ok && attempts < options_.max_rejection_tries) {
+      ++attempts;
       candidate = prior;
       if (dt > 0.0) {
         // Twist random walk (white-noise acceleration), then the constant-velocity step.
@@ -315,8 +319,14 @@ void BearingOnlyTracker::Propagate(double dt, const StepCues& c, std::vector<cha
       if (dt <= 0.0) break;  // nothing to redraw
     }
     particles_[i] = candidate;
-    if (!ok) {
-      (*violated)[i] = 1;
+    // A draw from the truncated transition carries the truncation's normalising constant,
+    // the probability of staying in psi, estimated as 1 / draws needed (without it the
+    // bounds act as reflecting walls: the accepted velocity noise near a bound points
+    // inward, and a constant-velocity particle keeps it).
+    if (ok) {
+      (*truncation_log_weight)[i] = -std::log(static_cast<double>(attempts));
+    } else {
+      (*truncation_log_weight)[i] = log_violation;
       ++violations;
     }
   }
@@ -459,13 +469,12 @@ void BearingOnlyTracker::SeatVelocities(const BotObservation& o, const StepCues&
 }
 
 bool BearingOnlyTracker::WeightByBearing(const BotObservation& o,
-                                         const std::vector<char>& violated) {
+                                         const std::vector<double>& truncation_log_weight) {
   const double sigma_px = o.bearing_sigma_px > 0.0 ? o.bearing_sigma_px : options_.bearing_sigma_px;
   const double eta = sigma_px / o.focal_px;
   const double inv_two_eta2 = 1.0 / (2.0 * eta * eta);
   const Eigen::Matrix3d R = o.cam_from_world.RotationMatrix();
   const Eigen::Vector3d t = o.cam_from_world.translation;
-  const double log_violation = std::log(options_.violation_weight);
   std::vector<double> r2(particles_.size());
   double best = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < particles_.size(); ++i) {
@@ -497,7 +506,7 @@ bool BearingOnlyTracker::WeightByBearing(const BotObservation& o,
   for (size_t i = 0; i < particles_.size(); ++i) {
     BotParticle& p = particles_[i];
     p.log_weight += std::isfinite(r2[i]) ? -r2[i] * inv_two_eta2 : kUnmeasurableLogWeight;
-    if (violated[i]) p.log_weight += log_violation;
+    p.log_weight += truncation_log_weight[i];
   }
   return true;
 }
@@ -689,10 +698,10 @@ Status BearingOnlyTracker::Update(const BotObservation& o) {
     return Status::Ok();
   }
 
-  std::vector<char> violated;
-  Propagate(dt, cues, &violated);
+  std::vector<double> truncation;
+  Propagate(dt, cues, &truncation);
   WeightBySfm(o);
-  WeightByBearing(o, violated);
+  WeightByBearing(o, truncation);
   if (NormalizeAndResample()) RegularizeDepths(cues);
   ApplySfmMotion(o);
   return Status::Ok();
@@ -711,12 +720,9 @@ Status BearingOnlyTracker::Predict(int64_t utime, const std::optional<GroundPlan
   }
   RebaseGroundHeights(ground_plane);
   const StepCues cues = MakeCues(nullptr);
-  std::vector<char> violated;
-  Propagate(static_cast<double>(utime - utime_) * kUsToS, cues, &violated);
-  const double log_violation = std::log(options_.violation_weight);
-  for (size_t i = 0; i < particles_.size(); ++i) {
-    if (violated[i]) particles_[i].log_weight += log_violation;
-  }
+  std::vector<double> truncation;
+  Propagate(static_cast<double>(utime - utime_) * kUsToS, cues, &truncation);
+  for (size_t i = 0; i < particles_.size(); ++i) particles_[i].log_weight += truncation[i];
   utime_ = utime;
   NormalizeAndResample();
   return Status::Ok();

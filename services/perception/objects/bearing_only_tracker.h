@@ -40,6 +40,8 @@
 //
 // Cues (each switchable, BotCues) define the set psi of admissible states; the motion
 // model is sampled truncated to psi by bounded rejection (max_rejection_tries redraws),
+// weighted by the estimated probability of staying in psi (1 / draws needed: the truncated
+// density's normalising constant, which keeps the bounds from acting as reflecting walls),
 // and a particle that still violates psi gets its weight multiplied by violation_weight:
 //   depth bound   camera depth within the caller's [min, max] along the ray (from the
 //                 static map's depths in the object's frustum);
@@ -346,10 +348,11 @@ class BearingOnlyTracker {
   StepCues MakeCues(const BotObservation* observation) const;
   bool InPsi(const BotParticle& particle, const StepCues& cues) const;
   void DrawInitialVelocity(BotParticle* particle, const StepCues& cues);
-  void Propagate(double dt, const StepCues& cues, std::vector<char>* violated);
+  void Propagate(double dt, const StepCues& cues, std::vector<double>* truncation_log_weight);
   void SeatVelocities(const BotObservation& observation, const StepCues& cues);
   void HoldOnRay(const BotObservation& observation);
-  bool WeightByBearing(const BotObservation& observation, const std::vector<char>& violated);
+  bool WeightByBearing(const BotObservation& observation,
+                       const std::vector<double>& truncation_log_weight);
   void WeightBySfm(const BotObservation& observation);
   void ApplySfmMotion(const BotObservation& observation);
   void RebaseGroundHeights(const std::optional<GroundPlane>& plane);

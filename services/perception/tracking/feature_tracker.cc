@@ -169,6 +169,12 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     next_tracks.push_back(std::move(t));
   }
 
+  // Wide baseline: when KLT kept too few, ORB descriptors re-match the lost tracks.
+  if (options_.descriptor_fallback && !prev_pts.empty() &&
+      static_cast<double>(stats_.tracked) < options_.fallback_survival * static_cast<double>(prev_pts.size())) {
+    MatchByDescriptors(prev_pyramid_[0], image, frame_index, &recently_lost_, &next_tracks);
+  }
+
   // Tracks coming out from behind a hull: re-found on their template.
   for (auto& [i, pred] : reappearing) {
     Track& t = tracks_[i];
@@ -227,6 +233,79 @@ int FeatureTracker::GuidedMatch(const std::unordered_map<int64_t, Eigen::Vector2
   stats_.recovered += found;
   if (found > 0) EnforceUnicity();
   return found;
+}
+
+void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat& image, int64_t frame_index,
+                                        std::vector<Track>* lost, std::vector<Track>* next_tracks) {
+  if (lost->empty()) return;
+  cv::Ptr<cv::ORB> orb = cv::ORB::create(options_.fallback_features);
+  // Descriptors of the lost tracks at their previous positions.
+  std::vector<cv::KeyPoint> prev_kps;
+  for (const Track& t : *lost) prev_kps.emplace_back(cv::Point2f(t.uv.x(), t.uv.y()), 31.0f);
+  cv::Mat prev_desc;
+  orb->compute(prev_image, prev_kps, prev_desc);  // drops keypoints too close to the border
+  if (prev_kps.empty()) return;
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  orb->detectAndCompute(image, cv::noArray(), kps, desc);
+  if (kps.size() < 2) return;
+  const float radius = static_cast<float>(options_.fallback_radius * std::hypot(image.cols, image.rows));
+  // For each lost track (by surviving keypoint), the best and second-best candidates.
+  std::vector<int> best_of(prev_kps.size(), -1);
+  std::vector<int> taken(kps.size(), -1);
+  std::vector<int> best_dist(prev_kps.size(), 256);
+  for (size_t i = 0; i < prev_kps.size(); ++i) {
+    int b1 = 256, b2 = 256, bi = -1;
+    for (size_t j = 0; j < kps.size(); ++j) {
+      const cv::Point2f d = kps[j].pt - prev_kps[i].pt;
+      if (d.dot(d) > radius * radius) continue;
+      const int dist = cv::norm(prev_desc.row(static_cast<int>(i)), desc.row(static_cast<int>(j)), cv::NORM_HAMMING);
+      if (dist < b1) {
+        b2 = b1;
+        b1 = dist;
+        bi = static_cast<int>(j);
+      } else if (dist < b2) {
+        b2 = dist;
+      }
+    }
+    if (bi < 0 || b1 > options_.fallback_max_hamming || b1 > options_.fallback_ratio * b2) continue;
+    // Unicity: a keypoint goes to the closest descriptor.
+    if (taken[static_cast<size_t>(bi)] >= 0 && best_dist[static_cast<size_t>(taken[static_cast<size_t>(bi)])] <= b1) continue;
+    if (taken[static_cast<size_t>(bi)] >= 0) best_of[static_cast<size_t>(taken[static_cast<size_t>(bi)])] = -1;
+    taken[static_cast<size_t>(bi)] = static_cast<int>(i);
+    best_of[i] = bi;
+    best_dist[i] = b1;
+  }
+  // ORB's compute() may drop keypoints: map them back to tracks by position.
+  std::vector<Track> still_lost;
+  std::vector<bool> used(lost->size(), false);
+  for (size_t i = 0; i < prev_kps.size(); ++i) {
+    if (best_of[i] < 0) continue;
+    for (size_t t = 0; t < lost->size(); ++t) {
+      if (used[t]) continue;
+      Track& tr = (*lost)[t];
+      if (std::abs(tr.uv.x() - prev_kps[i].pt.x) > 0.01f || std::abs(tr.uv.y() - prev_kps[i].pt.y) > 0.01f) continue;
+      const cv::Point2f& p = kps[static_cast<size_t>(best_of[i])].pt;
+      cv::Mat patch;
+      if (!ExtractPatch(image, Eigen::Vector2f(p.x, p.y), options_.patch_size, &patch)) break;
+      used[t] = true;
+      tr.prev_uv = tr.uv;
+      tr.uv = Eigen::Vector2f(p.x, p.y);
+      tr.velocity = tr.uv - tr.prev_uv;
+      tr.patch = patch;
+      tr.anchor = patch;  // appearance changes a lot across a wide baseline
+      ++tr.age;
+      tr.last_seen_frame = frame_index;
+      tr.match_error = 0.0f;
+      ++stats_.descriptor_matched;
+      next_tracks->push_back(std::move(tr));
+      break;
+    }
+  }
+  for (size_t t = 0; t < lost->size(); ++t) {
+    if (!used[t]) still_lost.push_back(std::move((*lost)[t]));
+  }
+  *lost = std::move(still_lost);
 }
 
 int64_t FeatureTracker::AdoptTrack(const Eigen::Vector2f& uv, int body_id) {

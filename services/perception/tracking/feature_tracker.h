@@ -42,6 +42,12 @@ struct TrackerOptions {
   double velocity_smoothing = 0.5;     // weight of the newest flow in the velocity estimate
   double min_patch_ncc = 0.6;          // appearance check of every KLT match against the track's template (NCC)
   double min_anchor_ncc = 0.4;         // ... and against its first appearance: catches tracks dragged along occlusion boundaries (NCC)
+  bool descriptor_fallback = true;     // when KLT keeps too few tracks (low frame rate, wide baseline), match ORB descriptors
+  double fallback_survival = 0.5;      // KLT survival share below which the fallback runs
+  int fallback_features = 1500;        // ORB features detected for the fallback (count)
+  int fallback_max_hamming = 50;       // descriptor acceptance (bits)
+  double fallback_ratio = 0.8;         // Lowe ratio test
+  double fallback_radius = 0.35;       // search radius (fraction of the image diagonal)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(max_features, 0);
@@ -65,6 +71,11 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION(velocity_smoothing > 0.0 && velocity_smoothing <= 1.0);
     MBSLAM_CHECK_OPTION(min_patch_ncc >= -1.0 && min_patch_ncc < 1.0);
     MBSLAM_CHECK_OPTION(min_anchor_ncc >= -1.0 && min_anchor_ncc < 1.0);
+    MBSLAM_CHECK_OPTION(fallback_survival >= 0.0 && fallback_survival <= 1.0);
+    MBSLAM_CHECK_OPTION_GT(fallback_features, 0);
+    MBSLAM_CHECK_OPTION(fallback_max_hamming > 0 && fallback_max_hamming <= 256);
+    MBSLAM_CHECK_OPTION(fallback_ratio > 0.0 && fallback_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION_GT(fallback_radius, 0.0);
     return true;
   }
   template <typename V>
@@ -89,6 +100,12 @@ struct TrackerOptions {
     v("velocity_smoothing", &velocity_smoothing, "weight of the newest flow in track velocity (0..1]");
     v("min_patch_ncc", &min_patch_ncc, "appearance check of KLT matches against the template (NCC)");
     v("min_anchor_ncc", &min_anchor_ncc, "appearance check against the first observation (NCC)");
+    v("descriptor_fallback", &descriptor_fallback, "ORB matching when KLT keeps too few tracks");
+    v("fallback_survival", &fallback_survival, "KLT survival share that triggers the fallback");
+    v("fallback_features", &fallback_features, "ORB features for the fallback (count)");
+    v("fallback_max_hamming", &fallback_max_hamming, "ORB acceptance distance (bits)");
+    v("fallback_ratio", &fallback_ratio, "Lowe ratio test of the fallback");
+    v("fallback_radius", &fallback_radius, "fallback search radius (fraction of the diagonal)");
   }
 };
 
@@ -112,6 +129,7 @@ struct TrackerStats {
   int recovered = 0;      // re-found by guided matching
   int created = 0;        // new features
   int rejected_unicity = 0;
+  int descriptor_matched = 0;  // recovered by the ORB fallback
 };
 
 class FeatureTracker {
@@ -143,6 +161,9 @@ class FeatureTracker {
  private:
   void DetectNew(const cv::Mat& image, int64_t frame_index);
   void EnforceUnicity();
+  // Wide-baseline fallback: lost tracks re-matched by ORB descriptors.
+  void MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat& image, int64_t frame_index,
+                          std::vector<Track>* lost, std::vector<Track>* next_tracks);
 
   const TrackerOptions options_;
   std::vector<cv::Mat> prev_pyramid_;
