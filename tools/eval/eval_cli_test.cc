@@ -11,6 +11,10 @@
 #include <memory>
 #include <string>
 
+#include "common/lcm/lcm_log.h"
+#include "mbslam/camera_pose_t.hpp"
+#include "mbslam/ground_truth_t.hpp"
+#include "mbslam/objects_t.hpp"
 #include "tools/eval/json.h"
 #include "tools/eval/trajectory.h"
 
@@ -130,6 +134,78 @@ TEST_F(EvalCli, PerturbLabelsThenSegRecoversTheKnownAnswer) {
   ASSERT_EQ(RunEval("seg --pred " + Path("pred.txt") + " --truth " + Path("truth.txt"), &seg), 0);
   EXPECT_DOUBLE_EQ(seg.Find("rate")->AsDouble(), 13.0 / 300.0);
   EXPECT_EQ(seg.Find("pred_groups")->AsDouble(), 4.0);
+}
+
+// A run log with poses (half scale), one object following a true body and its 0.2 s
+// predictions, plus the ground truth, all in one file.
+TEST_F(EvalCli, ObjectsFromLogs) {
+  const std::string path = Path("run.lcmlog");
+  {
+    Status st;
+    auto log = LcmLogWriter::Open(path, &st);
+    ASSERT_TRUE(log) << st.message();
+    auto set_pose = [](const Rigid3d& p, double position[3], double orientation[4]) {
+      for (int i = 0; i < 3; ++i) position[i] = p.translation[i];
+      orientation[0] = p.rotation.w();
+      orientation[1] = p.rotation.x();
+      orientation[2] = p.rotation.y();
+      orientation[3] = p.rotation.z();
+    };
+    for (int i = 0; i < 30; ++i) {
+      const int64_t t = 1000000 + i * 33333;
+      const Rigid3d cam(Eigen::Quaterniond(Eigen::AngleAxisd(0.02 * i, Eigen::Vector3d::UnitY())),
+                        Eigen::Vector3d(0.1 * i, 0.01 * i * i, 0.05 * i));
+      const Eigen::Vector3d body(6.0, -2.0 + 0.05 * i, 0.9);
+      mbslam::ground_truth_t gt{};
+      gt.utime = t;
+      gt.source = "test";
+      gt.has_camera = 1;
+      set_pose(cam, gt.cam_position, gt.cam_orientation);
+      mbslam::body_state_t b{};
+      b.id = 3;
+      b.name = "person";
+      set_pose(Rigid3d(Eigen::Quaterniond::Identity(), body), b.position, b.orientation);
+      gt.bodies.push_back(b);
+      gt.num_bodies = 1;
+      ASSERT_TRUE(log->Write("GROUND_TRUTH", t, gt).ok());
+      mbslam::camera_pose_t pose{};
+      pose.utime = t;
+      set_pose(Rigid3d(cam.rotation, 0.5 * cam.translation), pose.position, pose.orientation);
+      pose.tracking_state = mbslam::camera_pose_t::TRACKING_OK;
+      ASSERT_TRUE(log->Write("PERCEPTION_CAMERA_POSE", t, pose).ok());
+      mbslam::objects_t objs{};
+      objs.utime = t;
+      mbslam::object_t o{};
+      o.id = 8;
+      for (int k = 0; k < 3; ++k) o.position[k] = 0.5 * body[k];
+      o.orientation[0] = 1.0;
+      mbslam::predicted_volume_t v{};
+      v.horizon_us = 200000;
+      v.utime = t + v.horizon_us;
+      const Eigen::Vector3d future = 0.5 * (body + Eigen::Vector3d(0.0, 0.05 * 6, 0.0));
+      for (int k = 0; k < 3; ++k)
+        v.center[k] = future[k] + (i % 3 == 0 ? 1.0 : 0.0);  // a third miss
+      v.orientation[0] = 1.0;
+      v.half_extent[0] = v.half_extent[1] = v.half_extent[2] = 0.25;
+      o.volumes.push_back(v);
+      o.num_volumes = 1;
+      objs.objects.push_back(o);
+      objs.num_objects = 1;
+      ASSERT_TRUE(log->Write("PERCEPTION_OBJECTS", t, objs).ok());
+    }
+  }
+  Json j;
+  ASSERT_EQ(RunEval("objects --est-log " + path + " --gt-log " + path + " --horizon-us 200000", &j),
+            0);
+  EXPECT_EQ(j.Find("matched")->AsDouble(), 1.0);
+  EXPECT_LT(j.Find("camera_ate_rmse_m")->AsDouble(), 1e-9);
+  const Json& obj = (*j.Find("objects"))[0];
+  EXPECT_LT(obj.Find("position_rmse_m")->AsDouble(), 1e-9);
+  EXPECT_NEAR(obj.Find("best_scale")->AsDouble(), 1.0, 1e-9);
+  // Predictions 0.2 s ahead land within the truth for frames 0-22 (frame 23's is 2 µs
+  // past the last truth); every third (0, 3, ..., 21: 8 of them) is off by 1 m.
+  EXPECT_EQ(j.Find("volumes_checked")->AsDouble(), 23.0);
+  EXPECT_NEAR(j.Find("volume_hit_rate")->AsDouble(), 15.0 / 23.0, 1e-12);
 }
 
 }  // namespace
