@@ -9,14 +9,14 @@ namespace viewer {
 
 Rgb ObjectColor(int id) {
   static constexpr std::array<Rgb, kObjectPaletteSize> kPalette = {{
-      {255, 130, 0},   // orange
-      {30, 80, 255},   // blue
-      {230, 60, 200},  // magenta
-      {0, 180, 210},   // cyan
-      {130, 50, 220},  // purple
-      {150, 90, 30},   // brown
-      {255, 90, 120},  // pink
-      {0, 120, 120},   // teal
+      {255, 130, 0},    // orange
+      {30, 80, 255},    // blue
+      {230, 60, 200},   // magenta
+      {0, 180, 210},    // cyan
+      {130, 50, 220},   // purple
+      {255, 110, 150},  // pink
+      {0, 120, 120},    // teal
+      {20, 30, 140},    // navy
   }};
   const int k = ((id - 1) % kObjectPaletteSize + kObjectPaletteSize) % kObjectPaletteSize;
   return kPalette[static_cast<size_t>(k)];

@@ -30,6 +30,33 @@ void DrawSwatch(cv::Mat* image, const LegendEntry& e, cv::Point s0, cv::Point s1
 
 }  // namespace
 
+std::vector<std::string> WrapText(const std::string& text, int max_width, double scale) {
+  // Pieces end at "|" separators; lines are filled greedily.
+  std::vector<std::string> pieces;
+  size_t start = 0;
+  while (start < text.size()) {
+    const size_t bar = text.find('|', start);
+    const size_t end = bar == std::string::npos ? text.size() : bar + 1;
+    pieces.push_back(text.substr(start, end - start));
+    start = end;
+  }
+  std::vector<std::string> lines;
+  int baseline = 0;
+  for (const std::string& piece : pieces) {
+    const std::string candidate = lines.empty() ? piece : lines.back() + piece;
+    if (!lines.empty() &&
+        cv::getTextSize(candidate, cv::FONT_HERSHEY_SIMPLEX, scale, 1, &baseline).width <=
+            max_width) {
+      lines.back() = candidate;
+    } else {
+      const size_t first = piece.find_first_not_of(' ');  // a new line starts without blanks
+      lines.push_back(first == std::string::npos ? piece : piece.substr(first));
+    }
+  }
+  if (lines.empty()) lines.push_back("");
+  return lines;
+}
+
 void DrawOutlinedText(cv::Mat* image, const std::string& text, cv::Point origin, double scale,
                       const Rgb& color, int thickness) {
   const int luminance = (299 * color.r + 587 * color.g + 114 * color.b) / 1000;
@@ -72,22 +99,23 @@ void DrawLegend(cv::Mat* image, const std::vector<LegendEntry>& entries, cv::Poi
 }
 
 void DrawHeader(cv::Mat* image, const std::string& text, double scale) {
-  int baseline = 0;
-  const cv::Size m = cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, scale, 1, &baseline);
-  const cv::Rect band(0, 0, image->cols, std::min(image->rows, m.height + baseline + 10));
-  cv::Mat roi = (*image)(band);
-  cv::Mat dark(roi.size(), roi.type(), cv::Scalar(40, 40, 40));
-  cv::addWeighted(roi, 0.3, dark, 0.7, 0.0, roi);
-  cv::putText(*image, text, cv::Point(6, m.height + 5), cv::FONT_HERSHEY_SIMPLEX, scale,
-              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  const cv::Mat band = TextBand(image->cols, text, scale);
+  const cv::Rect rect(0, 0, image->cols, std::min(image->rows, band.rows));
+  cv::Mat roi = (*image)(rect);
+  cv::addWeighted(roi, 0.25, band(cv::Rect(0, 0, rect.width, rect.height)), 0.75, 0.0, roi);
 }
 
 cv::Mat TextBand(int width, const std::string& text, double scale) {
   int baseline = 0;
   const cv::Size m = cv::getTextSize("Mg", cv::FONT_HERSHEY_SIMPLEX, scale, 1, &baseline);
-  cv::Mat band(m.height + baseline + 10, std::max(1, width), CV_8UC3, cv::Scalar(40, 40, 40));
-  cv::putText(band, text, cv::Point(6, m.height + 5), cv::FONT_HERSHEY_SIMPLEX, scale,
-              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  const std::vector<std::string> lines = WrapText(text, std::max(1, width - 12), scale);
+  const int line_height = m.height + baseline + 4;
+  cv::Mat band(static_cast<int>(lines.size()) * line_height + 6, std::max(1, width), CV_8UC3,
+               cv::Scalar(40, 40, 40));
+  for (size_t i = 0; i < lines.size(); ++i) {
+    cv::putText(band, lines[i], cv::Point(6, 3 + m.height + static_cast<int>(i) * line_height),
+                cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  }
   return band;
 }
 

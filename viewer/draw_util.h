@@ -31,10 +31,15 @@ struct LegendEntry {
 void DrawLegend(cv::Mat* image, const std::vector<LegendEntry>& entries, cv::Point corner,
                 double scale);
 
-// A band along the top of the image with one line of text.
+// Splits text at its "|" separators into lines no wider than max_width (px), as far as
+// the pieces allow.
+std::vector<std::string> WrapText(const std::string& text, int max_width, double scale);
+
+// A dark band over the top of the image with the text (wrapped, see TextBand).
 void DrawHeader(cv::Mat* image, const std::string& text, double scale);
 
-// A dark band of the given width with one line of white text.
+// A dark band of the given width with the text in white, wrapped at its "|"
+// separators when it is too long for one line.
 cv::Mat TextBand(int width, const std::string& text, double scale);
 
 // A light band of the given width with the legend's entries side by side (wrapped onto

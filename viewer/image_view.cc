@@ -101,7 +101,9 @@ Status MakeImageViewInput(const SceneState& scene, int max_image_dimension, Imag
   return s;
 }
 
-void RenderImageView(const ImageViewOptions& options, const ImageViewInput& input, cv::Mat* bgr) {
+void RenderImageView(const ImageViewOptions& options, const ImageViewInput& input, cv::Mat* bgr,
+                     int* image_top) {
+  if (image_top) *image_top = 0;
   const TracksData* tracks = input.tracks;
   // The canvas: the image, or grey of the tracks' size, or a default size.
   cv::Mat canvas;
@@ -133,7 +135,7 @@ void RenderImageView(const ImageViewOptions& options, const ImageViewInput& inpu
   const double track_h = tracks && tracks->height > 0 ? tracks->height : source_h;
   map.sx = out_size.width / track_w;
   map.sy = out_size.height / track_h;
-  const double font = FontScaleFor(std::max(out_size.width, 900));  // as ImageViewTopBand
+  const double font = FontScaleFor(std::max(out_size.width, 900));
   const int radius = std::max(1, static_cast<int>(std::lround(options.feature_radius_px)));
 
   std::map<int, const ObjectData*> objects;
@@ -248,7 +250,9 @@ void RenderImageView(const ImageViewOptions& options, const ImageViewInput& inpu
         if (!any) continue;
         char text[96];
         auto it = objects.find(hull.body_id);
-        if (it != objects.end() && it->second->linear_velocity.allFinite()) {
+        // Objects only detected so far have no velocity estimate: no speed for them.
+        if (it != objects.end() && it->second->state != ObjectState::kDetected &&
+            it->second->linear_velocity.allFinite()) {
           std::snprintf(text, sizeof(text), "#%d  %.2f %s", hull.body_id,
                         it->second->linear_velocity.norm(), metric ? "m/s" : "units/s");
         } else {
@@ -289,11 +293,7 @@ void RenderImageView(const ImageViewOptions& options, const ImageViewInput& inpu
   cv::Mat top = TextBand(out_size.width, header, font);
   cv::Mat bottom = LegendBand(out_size.width, legend, font);
   cv::vconcat(std::vector<cv::Mat>{top, *bgr, bottom}, *bgr);
-}
-
-int ImageViewTopBand(const ImageViewOptions& options, int output_width) {
-  if (!options.show_legend) return 0;
-  return TextBand(output_width, "", FontScaleFor(std::max(output_width, 900))).rows;
+  if (image_top) *image_top = top.rows;
 }
 
 }  // namespace viewer

@@ -26,17 +26,15 @@ struct ImageViewInput {
 };
 
 // Draws the view (BGR). Never fails on odd data: features outside the image, NaNs and
-// degenerate hulls are skipped.
-void RenderImageView(const ImageViewOptions& options, const ImageViewInput& input, cv::Mat* bgr);
+// degenerate hulls are skipped. With the legend on, a header band sits above the image
+// and a legend band below it; `image_top` (optional) receives the header's height (px),
+// so a track at (u, v) of an image as wide as the output is drawn at (u, v + image_top).
+void RenderImageView(const ImageViewOptions& options, const ImageViewInput& input, cv::Mat* bgr,
+                     int* image_top = nullptr);
 
 // The input for the newest complete frame of `scene`: the image is decoded here; an
 // image that does not decode gives an error (the view can still be drawn without it).
 Status MakeImageViewInput(const SceneState& scene, int max_image_dimension, ImageViewInput* input);
-
-// With the legend on, a header band of this height (px) sits above the image and a
-// legend band below it; a track at (u, v) of an image as wide as the output is drawn at
-// (u, v + ImageViewTopBand(...)).
-int ImageViewTopBand(const ImageViewOptions& options, int output_width);
 
 // Pixel classes of the legend.
 enum class TrackClass { kStatic, kMoving, kUnassigned, kOccluded };

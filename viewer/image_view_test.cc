@@ -50,18 +50,19 @@ class ImageViewTest : public ::testing::Test {
     tracks_.hulls = {hull};
     ObjectData object;
     object.id = 3;
+    object.state = ObjectState::kTracked;
     object.linear_velocity = Eigen::Vector3d(3, 4, 0);  // 5 m/s
     objects_.metric = true;
     objects_.objects = {object};
   }
-  cv::Mat Render() {
+  cv::Mat Render(int* image_top = nullptr) {
     ImageViewInput input;
     input.image = image_;
     input.tracks = &tracks_;
     input.objects = &objects_;
     input.utime = 5;
     cv::Mat out;
-    RenderImageView(options_, input, &out);
+    RenderImageView(options_, input, &out, image_top);
     return out;
   }
 
@@ -179,8 +180,8 @@ TEST_F(ImageViewTest, BadValuesAreSkippedAndMissingPartsStillRender) {
 TEST_F(ImageViewTest, LegendBandsAndScalingMoveTheImage) {
   options_.show_legend = true;
   options_.scale = 2.0;
-  const cv::Mat out = Render();
-  const int top = ImageViewTopBand(options_, 640);
+  int top = -1;
+  const cv::Mat out = Render(&top);
   EXPECT_GT(top, 0);
   EXPECT_EQ(out.cols, 640);
   EXPECT_GT(out.rows, 480 + top);

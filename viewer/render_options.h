@@ -70,7 +70,7 @@ struct View3dOptions {
   std::array<double, 3> fixed_up = {0.0, 0.0,
                                     0.0};  // fixed: up direction; zeros = ground normal, else -y
   double framing_percentile = 2.0;  // auto framing ignores this share of map points at each end (%)
-  double point_size_px = 3.0;       // static map point diameter (px)
+  double point_size_px = 4.0;       // static map point diameter (px)
   std::string static_point_color =
       "height";  // height (above the ground plane) | rgb (image colour)
   std::array<double, 2> height_range = {

@@ -598,13 +598,19 @@ struct View3dRenderer::Impl {
     const double font = FontScaleFor(image->cols);
     // Object ids (and speeds) next to each object.
     for (const ObjectData& o : scene.objects().objects) {
+      // A detected object has no position estimate yet: labelled at its volume, if any.
+      const bool estimated = o.state != ObjectState::kDetected;
+      if (!estimated && o.volumes.empty()) continue;
+      const Eigen::Vector3d anchor = estimated ? o.position : o.volumes[0].center;
       Eigen::Vector2d px;
-      Eigen::Vector3d anchor = o.position;
-      if (o.state == ObjectState::kDetected && !o.volumes.empty()) anchor = o.volumes[0].center;
       if (!anchor.allFinite() || !camera.Project(anchor, &px)) continue;
       char text[64];
-      std::snprintf(text, sizeof(text), "#%d %.2f %s", o.id, o.linear_velocity.norm(),
-                    scene.objects().metric ? "m/s" : "u/s");
+      if (estimated && o.linear_velocity.allFinite()) {
+        std::snprintf(text, sizeof(text), "#%d %.2f %s", o.id, o.linear_velocity.norm(),
+                      scene.objects().metric ? "m/s" : "u/s");
+      } else {
+        std::snprintf(text, sizeof(text), "#%d", o.id);
+      }
       DrawOutlinedText(image, text,
                        cv::Point(static_cast<int>(px.x()) + 8, static_cast<int>(px.y()) - 8), font,
                        ObjectColor(o.id), 1);
@@ -615,7 +621,7 @@ struct View3dRenderer::Impl {
     const int state = current ? static_cast<int>(current->tracking_state) : 0;
     char header[512];
     std::snprintf(header, sizeof(header),
-                  "3D view (%s)  t = %s  camera: %s  %s  |  %zu map points, %zu keyframes, "
+                  "3D view (%s)  t = %s  camera: %s, %s  |  %zu map points, %zu keyframes, "
                   "%zu objects, %lld voxels",
                   options.camera_mode.c_str(), FormatSeconds(scene.latest_utime()).c_str(),
                   state >= 0 && state <= 4 ? states[state] : "?",
@@ -636,6 +642,9 @@ struct View3dRenderer::Impl {
     };
     int shown = 0;
     for (const ObjectData& o : scene.objects().objects) {
+      const bool drawn = o.state != ObjectState::kDetected || !o.points.empty() ||
+                         !o.particles.empty() || !o.volumes.empty();
+      if (!drawn) continue;
       if (shown++ >= 6) break;
       legend.push_back({"object #" + std::to_string(o.id) + ": points, trajectory, volumes",
                         ObjectColor(o.id), LegendEntry::Kind::kBox});
