@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include <Eigen/Eigenvalues>
+
 #include "common/util/logging.h"
 
 namespace mbslam {
@@ -178,7 +180,12 @@ bool BearingOnlyTracker::InPsi(const BotParticle& particle, const StepCues& c) c
 }
 
 void BearingOnlyTracker::DrawInitialVelocity(BotParticle* particle, const StepCues& c) {
-  const double speed = rng_.Uniform(options_.init_speed_min, options_.init_speed_max);
+  // Uniform density in the shell (3D) or annulus (in the plane): the speed's CDF goes with
+  // its cube or square.
+  const double a = options_.init_speed_min, b = options_.init_speed_max;
+  const double u = rng_.Uniform();
+  const double speed = c.ground ? std::sqrt(a * a + u * (b * b - a * a))
+                                : std::cbrt(a * a * a + u * (b * b * b - a * a * a));
   Eigen::Vector3d direction = Normal3(&rng_);
   if (c.ground) direction = InPlane(direction, c.plane.normal);
   const double n = direction.norm();
@@ -258,7 +265,7 @@ Status BearingOnlyTracker::InitializeImpl(const BotObservation& o,
   cam_from_world_ = o.cam_from_world;
   stats_.last_violation_share = static_cast<double>(violations) / n;
   NormalizeAndResample();
-  ApplySfmMotion(o);
+  RecordSfm(o);
   return Status::Ok();
 }
 
@@ -352,17 +359,16 @@ void BearingOnlyTracker::SeatVelocities(const BotObservation& o, const StepCues&
   // marginal likelihood of the two bearings over the velocity prior,
   //   integral prior(v(z)) z^2 dz   (z^2: volume per depth and image area at p2),
   // evaluated on kSeatCells cells of the depths whose speed is in [s_min, s_max], and z is
-  // drawn from the same integrand. Prior: uniform speed in all directions, density
-  // ~1/|v|^2; with the ground-plane cue uniform speed and heading in the plane, density
-  // ~1/|v_h|, times a Gaussian on the height change over dt whose sigma is the height
-  // tolerance and the bearing noise at both ends (a far particle's crossing with its own
-  // horizontal plane is too sensitive to the bearing noise to be taken exactly).
+  // drawn from the same integrand. Prior: uniform in the shell of speeds; with the
+  // ground-plane cue uniform in the annulus of horizontal speeds, times a Gaussian on the
+  // height change over dt whose sigma is the height tolerance and the bearing noise at both
+  // ends (a far particle's crossing with its own horizontal plane is too sensitive to the
+  // bearing noise to be taken exactly).
   const double dt = static_cast<double>(o.utime - init_utime_) * kUsToS;
   const Rigid3d world_from_cam = o.cam_from_world.Inverse();
   const Eigen::Vector3d c2 = world_from_cam.translation;
   const Eigen::Vector3d r2 = world_from_cam.rotation * o.xy.homogeneous();
   const double s_min = options_.init_speed_min, s_max = options_.init_speed_max;
-  const double floor = options_.prior_speed_floor;
   const double log_violation = std::log(options_.violation_weight);
   const double sigma_px = o.bearing_sigma_px > 0.0 ? o.bearing_sigma_px : options_.bearing_sigma_px;
   const double eta = sigma_px / o.focal_px;
@@ -427,12 +433,10 @@ void BearingOnlyTracker::SeatVelocities(const BotObservation& o, const StepCues&
           if (speed >= s_min && speed <= s_max) {
             const double sigma_h = std::sqrt(c.height_tolerance * c.height_tolerance +
                                              eta * eta * (z1 * z1 + zk * zk)) / dt;
-            density = std::exp(-0.5 * v_n * v_n / (sigma_h * sigma_h)) / sigma_h /
-                      std::max(speed, floor);
+            density = std::exp(-0.5 * v_n * v_n / (sigma_h * sigma_h)) / sigma_h;
           }
         } else {
-          const double speed = std::max(v.norm(), floor);
-          density = 1.0 / (speed * speed);
+          density = 1.0;  // the segments already hold the speeds in [s_min, s_max]
         }
         z_at[k] = zk;
         g[k] = zk * zk * density;
@@ -511,34 +515,78 @@ bool BearingOnlyTracker::WeightByBearing(const BotObservation& o,
   return true;
 }
 
-void BearingOnlyTracker::WeightBySfm(const BotObservation& o) {
-  if (!options_.cues.sfm_feedback || !o.sfm || sfm_history_.empty() || !seated_) return;
-  const SfmState& last = sfm_history_.back();
-  if (last.map_id != o.sfm->map_id) return;
-  const Eigen::Vector3d q = o.sfm->cam_from_obj * o.sfm->reference_in_obj;
-  if (!(q.z() > 0.0)) return;
-  const Rigid3d world_from_cam = o.cam_from_world.Inverse();
-  const double dt = std::max(static_cast<double>(o.utime - last.utime) * kUsToS, 0.0);
-  const double process = options_.position_sigma * options_.position_sigma * dt +
-                         options_.accel_sigma * options_.accel_sigma * dt * dt * dt / 3.0;
-  const double ratio2 = options_.sfm_sigma_ratio * options_.sfm_sigma_ratio;
-  for (BotParticle& p : particles_) {
-    if (!(p.sfm_scale > 0.0)) continue;
-    // Eq. 6.3: where the reconstruction puts this particle at its scale.
-    const Eigen::Vector3d q_s = p.sfm_scale * q;
-    const Eigen::Vector3d predicted = world_from_cam * q_s;
-    const double var = ratio2 * q_s.z() * q_s.z() + process;
-    p.log_weight -= (p.position - predicted).squaredNorm() / (2.0 * var);
+bool BearingOnlyTracker::SfmUsable(const BotObservation& o) const {
+  if (!options_.cues.sfm_feedback || !o.sfm || !seated_ || sfm_history_.empty()) return false;
+  if (sfm_history_.back().map_id != o.sfm->map_id || o.utime <= sfm_history_.back().utime) {
+    return false;
   }
+  return (o.sfm->cam_from_obj * o.sfm->reference_in_obj).z() > 0.0;
 }
 
-void BearingOnlyTracker::ApplySfmMotion(const BotObservation& o) {
+void BearingOnlyTracker::SfmStep(const BotObservation& o, double dt, const StepCues& c,
+                                 std::vector<double>* truncation_log_weight) {
+  // Given its scale s_i, a particle's positions are measured by the reconstruction,
+  // z_i(t) = world_from_cam * (s_i q(t)) with q the reference point in the camera in object
+  // units (eq. 6.3): a linear-Gaussian constant-velocity model per particle, run as a
+  // Kalman filter (per axis, the three axes share one 2x2 covariance). Its innovation
+  // likelihood weights the particle -- the distance between the motion model's prediction
+  // and the SfM-implied position -- and its update moves the particle with the SfM-implied
+  // motion (eq. 6.4, with the Kalman gain). The likelihood is that of the observed q, so
+  // it carries the Jacobian s^3 of z = s q.
+  truncation_log_weight->assign(particles_.size(), 0.0);
+  const double log_violation = std::log(options_.violation_weight);
+  const Eigen::Vector3d q = o.sfm->cam_from_obj * o.sfm->reference_in_obj;
+  const Rigid3d world_from_cam = o.cam_from_world.Inverse();
+  const double qa2 = options_.accel_sigma * options_.accel_sigma;
+  const double qp2 = options_.position_sigma * options_.position_sigma;
+  const double ratio2 = options_.sfm_sigma_ratio * options_.sfm_sigma_ratio;
+  const double scale_step = options_.sfm_scale_sigma * std::sqrt(dt);
+  const Eigen::Vector3d n = c.plane.normal;
+  int violations = 0;
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    BotParticle& p = particles_[i];
+    if (!(p.sfm_scale > 0.0)) continue;
+    if (scale_step > 0.0) p.sfm_scale *= std::exp(scale_step * rng_.Normal());
+    const double s = p.sfm_scale;
+    // Predict.
+    Eigen::Vector3d position = p.position + p.linear_velocity * dt;
+    const double pp = p.kf_pp + 2.0 * dt * p.kf_pv + dt * dt * p.kf_vv + qa2 * dt * dt * dt / 3.0 +
+                      qp2 * dt;
+    const double pv = p.kf_pv + dt * p.kf_vv + 0.5 * qa2 * dt * dt;
+    const double vv = p.kf_vv + qa2 * dt;
+    // Update with the SfM-implied position.
+    const Eigen::Vector3d measured = world_from_cam * (s * q);
+    const double r = ratio2 * (s * q.z()) * (s * q.z());
+    const double S = pp + r;
+    const Eigen::Vector3d y = measured - position;
+    p.log_weight += -0.5 * y.squaredNorm() / S - 1.5 * std::log(S) + 3.0 * std::log(s);
+    const double kp = pp / S, kv = pv / S;
+    position += kp * y;
+    p.linear_velocity += kv * y;
+    p.kf_pp = (1.0 - kp) * pp;
+    p.kf_pv = (1.0 - kp) * pv;
+    p.kf_vv = vv - kv * pv;
+    if (c.ground) {
+      // The ground plane keeps the height and the horizontal motion.
+      position -= (c.plane.Height(position) - p.ground_height) * n;
+      p.linear_velocity = InPlane(p.linear_velocity, n);
+    }
+    p.position = position;
+    if (!InPsi(p, c)) {
+      (*truncation_log_weight)[i] = log_violation;
+      ++violations;
+    }
+  }
+  stats_.last_violation_share =
+      particles_.empty() ? 0.0 : static_cast<double>(violations) / particles_.size();
+}
+
+void BearingOnlyTracker::RecordSfm(const BotObservation& o) {
   if (!options_.cues.sfm_feedback || !o.sfm) return;
   const Eigen::Vector3d q = o.sfm->cam_from_obj * o.sfm->reference_in_obj;
   if (!(q.z() > 0.0)) return;
-  if (!sfm_history_.empty() && sfm_history_.back().map_id != o.sfm->map_id) {
-    sfm_history_.clear();  // a new reconstruction: its scale is unrelated to the old one
-  }
+  const bool new_map = sfm_history_.empty() || sfm_history_.back().map_id != o.sfm->map_id;
+  if (new_map) sfm_history_.clear();  // a new reconstruction: its scale is unrelated
   SfmState now;
   now.map_id = o.sfm->map_id;
   now.utime = o.utime;
@@ -546,9 +594,8 @@ void BearingOnlyTracker::ApplySfmMotion(const BotObservation& o) {
   now.reference_in_cam = q;
   now.world_from_obj_rotation =
       (now.world_from_cam.rotation * o.sfm->cam_from_obj.rotation).normalized();
-
-  // The SfM-implied twist over at least the baseline: the newest older image that far back
-  // (none yet: a twist from images closer in time is mostly the reconstruction's noise).
+  // The reconstruction's angular velocity over at least the baseline (closer images give
+  // mostly its noise).
   const SfmState* ref = nullptr;
   for (auto it = sfm_history_.rbegin(); it != sfm_history_.rend(); ++it) {
     if (it->utime < o.utime && o.utime - it->utime >= options_.sfm_velocity_baseline_us) {
@@ -556,35 +603,30 @@ void BearingOnlyTracker::ApplySfmMotion(const BotObservation& o) {
       break;
     }
   }
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+  if (ref != nullptr) {
+    const double dt = static_cast<double>(o.utime - ref->utime) * kUsToS;
+    w = LogSO3((now.world_from_obj_rotation * ref->world_from_obj_rotation.conjugate())
+                   .toRotationMatrix()) / dt;
+  }
   const Eigen::Matrix3d R_cw = o.cam_from_world.RotationMatrix();
   const Eigen::Vector3d t_cw = o.cam_from_world.translation;
-  const double g = options_.sfm_velocity_gain;
-  Eigen::Vector3d w_sfm = Eigen::Vector3d::Zero();
-  double dt = 0.0;
-  if (ref != nullptr) {
-    dt = static_cast<double>(o.utime - ref->utime) * kUsToS;
-    w_sfm = LogSO3((now.world_from_obj_rotation * ref->world_from_obj_rotation.conjugate())
-                       .toRotationMatrix()) / dt;
-  }
-  const bool ground = options_.cues.ground_plane && FiniteGroundPlane(plane_);
+  const double velocity_var = options_.accel_sigma * options_.accel_sigma * 1.0;  // 1 s of it
   for (BotParticle& p : particles_) {
+    p.rotation = now.world_from_obj_rotation;
+    if (ref != nullptr) p.angular_velocity = w;
+    if (!new_map && p.sfm_scale > 0.0) continue;
+    // Its scale from its depth: s_i = d_i / d_SfM; the Kalman filter starts from the
+    // particle's state.
     const double z = R_cw.row(2).dot(p.position) + t_cw.z();
     if (z <= options_.min_depth) continue;
-    const double s = z / q.z();
-    p.sfm_scale = s;
-    p.rotation = now.world_from_obj_rotation;
-    if (ref != nullptr && seated_) {
-      // Eq. 6.4: the survivor moves with the reconstruction's motion at its own scale.
-      Eigen::Vector3d v = (now.world_from_cam * (s * q) -
-                           ref->world_from_cam * (s * ref->reference_in_cam)) / dt;
-      if (ground) v = InPlane(v, plane_->normal);
-      p.linear_velocity = (1.0 - g) * p.linear_velocity + g * v;
-      p.angular_velocity = (1.0 - g) * p.angular_velocity + g * w_sfm;
-    }
+    p.sfm_scale = z / q.z();
+    p.kf_pp = options_.sfm_sigma_ratio * options_.sfm_sigma_ratio * z * z;
+    p.kf_pv = 0.0;
+    p.kf_vv = velocity_var;
   }
   orientation_tracked_ = true;
   sfm_history_.push_back(now);
-  // Keep what the baseline needs (and a little more).
   while (sfm_history_.size() > 2 &&
          o.utime - sfm_history_[1].utime >= options_.sfm_velocity_baseline_us) {
     sfm_history_.pop_front();
@@ -632,31 +674,42 @@ bool BearingOnlyTracker::NormalizeAndResample() {
 }
 
 void BearingOnlyTracker::RegularizeDepths(const StepCues& cues) {
+  // Liu-West kernel smoothing of (log depth, velocity) with their empirical covariance:
+  // x' = a x + (1 - a) mean + h L e, a = sqrt(1 - h^2), L L^T = covariance. Mean and
+  // covariance are kept (so is the depth-velocity correlation of the one-parameter family
+  // the bearings cannot tell apart); duplicates of a few survivors spread again.
   const size_t n = particles_.size();
-  if (options_.depth_regularization <= 0.0 || n < 2 || !cues.has_camera) return;
-  std::vector<double> log_z(n);
-  double mean = 0.0;
+  if (options_.depth_regularization <= 0.0 || n < 8 || !cues.has_camera) return;
+  using Vector4 = Eigen::Matrix<double, 4, 1>;
+  using Matrix4 = Eigen::Matrix<double, 4, 4>;
+  std::vector<Vector4> x(n);
+  Vector4 mean = Vector4::Zero();
   for (size_t i = 0; i < n; ++i) {
     const double z = cues.Depth(particles_[i].position);
     if (!(z > 0.0)) return;
-    log_z[i] = std::log(z);
-    mean += log_z[i];
+    x[i] << std::log(z), particles_[i].linear_velocity;
+    mean += x[i];
   }
   mean /= static_cast<double>(n);  // weights are uniform right after resampling
-  double var = 0.0;
-  for (double l : log_z) var += (l - mean) * (l - mean);
-  const double sigma = std::sqrt(var / static_cast<double>(n));
-  // Silverman's bandwidth for one dimension, Liu-West shrinkage a = sqrt(1 - h^2).
-  const double h = std::min(0.9, options_.depth_regularization * std::pow(4.0 / 3.0, 0.2) *
-                                     std::pow(static_cast<double>(n), -0.2));
+  Matrix4 cov = Matrix4::Zero();
+  for (const Vector4& xi : x) cov += (xi - mean) * (xi - mean).transpose();
+  cov /= static_cast<double>(n);
+  Eigen::SelfAdjointEigenSolver<Matrix4> eig(cov);
+  if (eig.info() != Eigen::Success) return;
+  const Matrix4 L =
+      eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+  // Silverman's bandwidth for four dimensions, scaled by the option.
+  const double h = std::min(0.9, options_.depth_regularization * std::pow(4.0 / 6.0, 1.0 / 8.0) *
+                                     std::pow(static_cast<double>(n), -1.0 / 8.0));
   const double a = std::sqrt(1.0 - h * h);
   for (size_t i = 0; i < n; ++i) {
     BotParticle& p = particles_[i];
-    const double target = a * log_z[i] + (1.0 - a) * mean + h * sigma * rng_.Normal();
-    const double f = std::exp(target - log_z[i]);
+    const Vector4 e(rng_.Normal(), rng_.Normal(), rng_.Normal(), rng_.Normal());
+    const Vector4 target = a * x[i] + (1.0 - a) * mean + h * (L * e);
+    const double f = std::exp(target[0] - x[i][0]);
     BotParticle moved = p;
-    moved.position = cues.center + f * (p.position - cues.center);
-    moved.linear_velocity = camera_velocity_ + f * (p.linear_velocity - camera_velocity_);
+    moved.position = cues.center + f * (p.position - cues.center);  // along its viewing ray
+    moved.linear_velocity = target.tail<3>();
     if (cues.has_plane) {
       moved.ground_height = cues.plane.Height(moved.position);
       if (cues.ground) moved.linear_velocity = InPlane(moved.linear_velocity, cues.plane.normal);
@@ -694,16 +747,19 @@ Status BearingOnlyTracker::Update(const BotObservation& o) {
     }
     SeatVelocities(o, cues);
     if (NormalizeAndResample()) RegularizeDepths(cues);
-    ApplySfmMotion(o);
+    RecordSfm(o);
     return Status::Ok();
   }
 
   std::vector<double> truncation;
-  Propagate(dt, cues, &truncation);
-  WeightBySfm(o);
+  if (SfmUsable(o)) {
+    SfmStep(o, dt, cues, &truncation);
+  } else {
+    Propagate(dt, cues, &truncation);
+  }
   WeightByBearing(o, truncation);
   if (NormalizeAndResample()) RegularizeDepths(cues);
-  ApplySfmMotion(o);
+  RecordSfm(o);
   return Status::Ok();
 }
 

@@ -20,23 +20,23 @@
 // Measurement (eq. 5.2): z_i = project(cam_from_world * translation(g_i)) in normalised
 // image coordinates; log-weight -|z - z_i|^2 / (2 eta^2), eta = bearing_sigma_px / focal.
 // Systematic resampling when the effective sample size falls below a share of N, then a
-// regularisation along the unobservable direction: each particle slides along its viewing
-// ray by a log-depth kernel with Liu-West shrinkage (mean and spread of the log-depths are
-// kept), its velocity rescaled along the same one-parameter family (v_cam + f (v - v_cam)),
-// so that duplicates of a few survivors spread again in depth and the cloud can follow
+// regularisation (Liu-West kernel smoothing with shrinkage) of each particle's log-depth
+// along its viewing ray and its velocity, with their empirical covariance: mean and
+// covariance are kept, duplicates of a few survivors spread again, and the cloud can follow
 // evidence that arrives later (without it, particles near the truth that a wide prior
-// down-weighted early are lost for good).
+// down-weighted early are lost for good, and the genealogy collapses onto a few ancestors
+// in the directions the bearings cannot observe).
 //
 // Initialisation (sec. 5.1.2): depths uniform in [d_min, d_max] along the viewing ray (the
 // depth bound when given), or N(d, sigma^2) around the mapped depth of a previously static
-// object. Speeds uniform in [s_min, s_max] in all directions (in the ground plane with the
+// object. Velocities uniform over all directions with speeds in [s_min, s_max] (uniform
+// density in that spherical shell, or in the annulus of the ground plane with the
 // ground-plane cue) are drawn at once for the estimate, and then *seated* at the first
 // bearing at least init_velocity_baseline_us later: instead of leaving almost every blind
 // velocity draw to die (the bearing fixes two velocity components within a few cm/s), each
 // particle draws its velocity among those that carry it onto the new bearing, with the
-// importance weight prior(v) * |d velocity / d(depth, image)| of the thesis's speed prior
-// (the prior density of a uniform speed in all directions is ~1/|v|^2, or 1/|v| in the
-// plane; it is capped below prior_speed_floor).
+// importance weight of that prior (its integral along the line of such velocities, times
+// the volume factor z^2 of the new depth z).
 //
 // Cues (each switchable, BotCues) define the set psi of admissible states; the motion
 // model is sampled truncated to psi by bounded rejection (max_rejection_tries redraws),
@@ -52,11 +52,15 @@
 //                 most max_ground_clearance up), nor taller than max_object_height;
 //   SfM feedback  (eq. 6.3-6.4) with the object's own reconstruction (cam_from_obj up to
 //                 a scale and the reference point in it): particle i's depth d_i fixes its
-//                 scale s_i = d_i / d_SfM and so its position in the next image,
-//                 t_i = R_cw^T (s_i t_co - t_cw); the distance of the motion-model
-//                 prediction to it weights the particle, and survivors move with the
-//                 SfM-implied twist at their scale (g_i(t+1) = exp(xi_i,SfM^ dt) g_i(t)),
-//                 turning with the object's reconstructed rotation.
+//                 scale s_i = d_i / d_SfM, and with it every position the reconstruction
+//                 implies, t_i = R_cw^T (s_i t_co - t_cw). These act as a secondary
+//                 observation: each particle runs a constant-velocity Kalman filter on its
+//                 SfM-implied positions (the particle is then (s_i, its Kalman state): a
+//                 Rao-Blackwellised filter), whose innovation -- the distance between the
+//                 motion model's prediction and t_i -- weights it, and whose update moves it
+//                 with the SfM-implied motion (eq. 6.4 with the Kalman gain). A scale whose
+//                 trajectory is not a constant-velocity motion on the ground (the camera
+//                 accelerates, bobs, turns) loses weight; the rotation comes from R_cw^T R_co.
 //
 // Units: "units" are world units (metres once the static map is metric). Time is int64 µs.
 // Deterministic: the generator is seeded from options.seed and the object id.
@@ -103,9 +107,8 @@ struct BearingOnlyTrackerOptions {
   // Initialisation (sec. 5.1.2).
   double init_depth_min = 1.0;              // depth range along the ray without a depth bound (units)
   double init_depth_max = 60.0;             // (units)
-  double init_speed_min = 0.0;              // speed prior, uniform in all directions (units/s)
+  double init_speed_min = 0.0;              // velocity prior: uniform, speeds in [min, max] (units/s)
   double init_speed_max = 15.0;             // (units/s)
-  double prior_speed_floor = 0.3;           // the speed prior's density is capped below this speed (units/s)
   int64_t init_velocity_baseline_us = 300000;  // velocities are seated at the first bearing this much later (µs)
   double static_depth_sigma_ratio = 0.05;   // previously static object: depth sigma / depth when not given
   // Motion model (eq. 5.1).
@@ -117,7 +120,7 @@ struct BearingOnlyTrackerOptions {
   double bearing_sigma_px = 2.0;            // eta: bearing noise of the reference point (px)
   double min_depth = 0.2;                   // particles nearer than this to the camera are invalid (units)
   double resample_ess_ratio = 0.5;          // resample when ESS < ratio * N (0, 1]
-  double depth_regularization = 1.0;        // after resampling, log-depth kernel of this x Silverman's bandwidth (0 = off)
+  double depth_regularization = 1.0;        // after resampling, (log depth, velocity) kernel of this x Silverman's bandwidth (0 = off)
   double lost_residual_px = 40.0;           // no particle this close to the bearing: particles move onto the ray (px)
   // Truncated sampling (sec. 5.1.3).
   int max_rejection_tries = 10;             // redraws to satisfy the cue set psi (count)
@@ -132,8 +135,8 @@ struct BearingOnlyTrackerOptions {
   double size_bound_percentile = 0.05;      // robust lowest / highest track: this percentile [0, 0.5)
   int size_bound_min_tracks = 3;            // fewer tracks: no size bound in that image (count)
   double sfm_sigma_ratio = 0.01;            // SfM position noise, fraction of the depth (ratio)
-  double sfm_velocity_gain = 1.0;           // share of the SfM-implied twist a survivor takes [0, 1] (1 = eq. 6.4)
-  int64_t sfm_velocity_baseline_us = 300000;  // SfM-implied twist over at least this time (µs)
+  double sfm_scale_sigma = 0.01;            // random walk of each particle's log scale under SfM (1/s^0.5)
+  int64_t sfm_velocity_baseline_us = 300000;  // SfM angular velocity over at least this time (µs)
   // Outputs.
   int num_output_samples = 100;             // particle positions in the estimate (count)
   double reliable_depth_sigma_ratio = 0.2;  // estimate reliable when depth sigma / depth below (ratio)
@@ -146,7 +149,6 @@ struct BearingOnlyTrackerOptions {
     MBSLAM_CHECK_OPTION_GT(init_depth_max, init_depth_min);
     MBSLAM_CHECK_OPTION_GE(init_speed_min, 0.0);
     MBSLAM_CHECK_OPTION_GT(init_speed_max, init_speed_min);
-    MBSLAM_CHECK_OPTION_GT(prior_speed_floor, 0.0);
     MBSLAM_CHECK_OPTION_GE(init_velocity_baseline_us, 0);
     MBSLAM_CHECK_OPTION_GT(static_depth_sigma_ratio, 0.0);
     MBSLAM_CHECK_OPTION_GE(accel_sigma, 0.0);
@@ -169,7 +171,7 @@ struct BearingOnlyTrackerOptions {
     MBSLAM_CHECK_OPTION(size_bound_percentile >= 0.0 && size_bound_percentile < 0.5);
     MBSLAM_CHECK_OPTION_GE(size_bound_min_tracks, 1);
     MBSLAM_CHECK_OPTION_GT(sfm_sigma_ratio, 0.0);
-    MBSLAM_CHECK_OPTION(sfm_velocity_gain >= 0.0 && sfm_velocity_gain <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(sfm_scale_sigma, 0.0);
     MBSLAM_CHECK_OPTION_GE(sfm_velocity_baseline_us, 0);
     MBSLAM_CHECK_OPTION_GE(num_output_samples, 0);
     MBSLAM_CHECK_OPTION_GT(reliable_depth_sigma_ratio, 0.0);
@@ -181,9 +183,8 @@ struct BearingOnlyTrackerOptions {
     v("num_particles", &num_particles, "particles per object (count)");
     v("init_depth_min", &init_depth_min, "depth range along the ray without a depth bound (units)");
     v("init_depth_max", &init_depth_max, "(units)");
-    v("init_speed_min", &init_speed_min, "speed prior, uniform in all directions (units/s)");
+    v("init_speed_min", &init_speed_min, "velocity prior: uniform, speeds in [min, max] (units/s)");
     v("init_speed_max", &init_speed_max, "(units/s)");
-    v("prior_speed_floor", &prior_speed_floor, "speed prior density capped below this speed (units/s)");
     v("init_velocity_baseline_us", &init_velocity_baseline_us,
       "velocities seated at the first bearing this much later (us)");
     v("static_depth_sigma_ratio", &static_depth_sigma_ratio,
@@ -196,7 +197,7 @@ struct BearingOnlyTrackerOptions {
     v("min_depth", &min_depth, "particles nearer than this are invalid (units)");
     v("resample_ess_ratio", &resample_ess_ratio, "resample when ESS < ratio * N (0, 1]");
     v("depth_regularization", &depth_regularization,
-      "log-depth kernel after resampling, x Silverman's bandwidth (0 = off)");
+      "(log depth, velocity) kernel after resampling, x Silverman's bandwidth (0 = off)");
     v("lost_residual_px", &lost_residual_px, "no particle this close: particles move onto the ray (px)");
     v("max_rejection_tries", &max_rejection_tries, "redraws to satisfy the cue set (count)");
     v("violation_weight", &violation_weight, "weight factor of a particle outside the cue set (0, 1]");
@@ -209,8 +210,8 @@ struct BearingOnlyTrackerOptions {
     v("size_bound_percentile", &size_bound_percentile, "robust lowest / highest track percentile [0, 0.5)");
     v("size_bound_min_tracks", &size_bound_min_tracks, "fewer tracks: no size bound (count)");
     v("sfm_sigma_ratio", &sfm_sigma_ratio, "SfM position noise, fraction of the depth");
-    v("sfm_velocity_gain", &sfm_velocity_gain, "share of the SfM-implied twist a survivor takes [0, 1]");
-    v("sfm_velocity_baseline_us", &sfm_velocity_baseline_us, "SfM-implied twist over at least this time (us)");
+    v("sfm_scale_sigma", &sfm_scale_sigma, "random walk of each particle's log scale under SfM (1/s^0.5)");
+    v("sfm_velocity_baseline_us", &sfm_velocity_baseline_us, "SfM angular velocity over at least this time (us)");
     v("num_output_samples", &num_output_samples, "particle positions in the estimate (count)");
     v("reliable_depth_sigma_ratio", &reliable_depth_sigma_ratio, "reliable when depth sigma / depth below");
     v("volumes", &volumes, "predicted volumes");
@@ -253,7 +254,10 @@ struct BotParticle {
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // w, world axes (rad/s)
   double log_weight = 0.0;    // normalised: sum of exp = 1
   double ground_height = 0.0; // height above the ground kept by the ground-plane cue (units)
-  double sfm_scale = 0.0;     // s_i = d_i / d_SfM at the last SfM image, 0 if none
+  double sfm_scale = 0.0;     // s_i = d_i / d_SfM (world units per object map unit), 0 if none
+  // Under SfM feedback: per-axis covariance of (position, velocity) of the particle's
+  // Kalman filter on the SfM-implied positions (units^2, units^2/s, units^2/s^2).
+  double kf_pp = 0.0, kf_pv = 0.0, kf_vv = 0.0;
   Eigen::Vector3d init_position = Eigen::Vector3d::Zero();  // at initialisation (velocity seating)
 
   Rigid3d world_from_particle() const { return Rigid3d(rotation, position); }
@@ -353,8 +357,10 @@ class BearingOnlyTracker {
   void HoldOnRay(const BotObservation& observation);
   bool WeightByBearing(const BotObservation& observation,
                        const std::vector<double>& truncation_log_weight);
-  void WeightBySfm(const BotObservation& observation);
-  void ApplySfmMotion(const BotObservation& observation);
+  bool SfmUsable(const BotObservation& observation) const;
+  void SfmStep(const BotObservation& observation, double dt, const StepCues& cues,
+               std::vector<double>* truncation_log_weight);
+  void RecordSfm(const BotObservation& observation);
   void RebaseGroundHeights(const std::optional<GroundPlane>& plane);
   // Returns true when it resampled.
   bool NormalizeAndResample();

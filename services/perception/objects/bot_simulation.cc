@@ -15,7 +15,9 @@ constexpr double kWallHeight = 10.0;
 
 struct CameraScenario {
   double height;   // (m)
-  double speed;    // forward (m/s)
+  double speed;    // mean forward speed (m/s)
+  double surge;    // forward speed variation amplitude (m/s)
+  double surge_hz;
   double bob;      // vertical amplitude (m)
   double bob_hz;
   double sway;     // lateral amplitude (m)
@@ -33,9 +35,11 @@ struct TargetScenario {
 
 CameraScenario CameraFor(BotSimCamera camera) {
   if (camera == BotSimCamera::kCar) {
-    return {1.4, 6.0, 0.006, 2.3, 0.0, 0.5, 0.003, 0.004, 0.002};
+    // Speed varies by +-1.5 m/s over 5 s (traffic), the suspension bobs a few mm.
+    return {1.4, 6.0, 1.5, 0.2, 0.006, 2.3, 0.0, 0.5, 0.003, 0.004, 0.002};
   }
-  return {1.5, 1.2, 0.04, 1.8, 0.03, 0.9, 0.026, 0.035, 0.017};
+  // Walking: the pace surges with each step, the camera bobs, sways and turns a little.
+  return {1.5, 1.2, 0.1, 1.8, 0.04, 1.8, 0.03, 0.9, 0.026, 0.035, 0.017};
 }
 
 TargetScenario TargetFor(BotSimCamera camera, BotSimTarget target) {
@@ -55,7 +59,10 @@ TargetScenario TargetFor(BotSimCamera camera, BotSimTarget target) {
 // turned by the wiggle.
 Rigid3d WorldFromCam(const CameraScenario& c, double wiggle, double t) {
   const double w = 2.0 * M_PI;
-  const Eigen::Vector3d position(c.speed * t, wiggle * c.sway * std::sin(w * c.sway_hz * t + 0.5),
+  // x(t) = integral of speed + wiggle * surge * sin(w f t), starting at 0.
+  const double surge = wiggle * c.surge / (w * c.surge_hz) * (1.0 - std::cos(w * c.surge_hz * t));
+  const Eigen::Vector3d position(c.speed * t + surge,
+                                 wiggle * c.sway * std::sin(w * c.sway_hz * t + 0.5),
                                  c.height + wiggle * c.bob * std::sin(w * c.bob_hz * t));
   Eigen::Matrix3d base;
   base << 0, 0, 1, -1, 0, 0, 0, -1, 0;

@@ -3,8 +3,9 @@
 
 // Synthetic scenes for the bearing-only tracker (tests, the cue ablation tool and the
 // benchmark; not used by the service). A camera moves forward over a flat ground (z = 0,
-// world x forward, y left, z up) between two building facades, either like a car or
-// hand-held by a walking person (vertical bob, sway and small rotations), and watches a
+// world x forward, y left, z up) between two building facades, either like a car (speed
+// changing with the traffic, a few mm of suspension bob) or hand-held by a walking person
+// (pace surging with each step, vertical bob, sway and small rotations), and watches a
 // box-shaped target that moves at constant velocity on the ground: ahead of the camera in
 // the same direction (following: the degenerate case for monocular motion segmentation
 // and bearing-only tracking) or across its path (crossing). Every image gives the
@@ -37,13 +38,13 @@ const char* BotSimTargetName(BotSimTarget target);
 struct BotSimOptions {
   BotSimCamera camera = BotSimCamera::kHandHeld;
   BotSimTarget target = BotSimTarget::kFollowing;
-  double wiggle_scale = 1.0;        // scales the camera's bob / sway / rotations (0 = smooth)
+  double wiggle_scale = 1.0;        // scales the camera's speed changes, bob, sway, rotations (0 = smooth)
   double fps = 30.0;                // image rate (Hz)
   double duration_s = 3.0;          // sequence length (s)
   double focal_px = 500.0;          // pinhole focal length (px), 640 x 480 images
   double bearing_noise_px = 1.0;    // noise of the reference bearing (px)
   double track_noise_px = 0.5;      // noise of each track (px)
-  int num_target_points = 60;       // feature points on the target, seen when their face is (count)
+  int num_target_points = 150;      // feature points on the target, seen when their face is (count)
   double sfm_relative_scale = 3.0;  // true scale: world units per object map unit
   double sfm_start_s = 0.5;         // the target's reconstruction exists from this time (s)
   double sfm_rotation_noise_rad = 0.002;       // per image (rad)
