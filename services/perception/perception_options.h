@@ -49,6 +49,7 @@ struct PerceptionOptions {
   PersonDetectorOptions person;
   OdometryOptions odometry;
   SlamOptions slam;
+  GroundPlaneOptions ground;
 
   CoreOptions core() const {
     CoreOptions c;
@@ -58,6 +59,7 @@ struct PerceptionOptions {
     c.person = person;
     c.odometry = odometry;
     c.slam = slam;
+    c.ground = ground;
     // Lockstep replays must be deterministic: bundle adjustment runs inline there.
     if (pipeline.lockstep()) c.slam.background_ba = false;
     return c;
@@ -74,6 +76,7 @@ struct PerceptionOptions {
     MBSLAM_CHECK_OPTION_SECTION(person);
     MBSLAM_CHECK_OPTION_SECTION(odometry);
     MBSLAM_CHECK_OPTION_SECTION(slam);
+    MBSLAM_CHECK_OPTION_SECTION(ground);
     return true;
   }
   template <typename V>
@@ -88,6 +91,7 @@ struct PerceptionOptions {
     v("person", &person, "person detection in moving regions (thesis sec. 3.9.4)");
     v("odometry", &odometry, "ego-motion from wheel odometry (thesis sec. 3.8)");
     v("slam", &slam, "static-world keyframe SLAM (thesis ch. 4)");
+    v("ground", &ground, "ground plane from the static map (sec. 5.1.1)");
   }
 };
 

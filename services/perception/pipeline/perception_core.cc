@@ -30,6 +30,7 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
 
 void PerceptionCore::Reset() {
   slam_.Reset();
+  ground_.reset();
   tracker_.Reset();
   segmenter_.Reset();
   odometry_.Clear();
@@ -113,6 +114,53 @@ void PerceptionCore::FillCameraPose(const SlamPose& pose, CameraPoseOutput* out)
   out->num_keyframes = static_cast<int>(slam_.map().num_keyframes());
 }
 
+void PerceptionCore::UpdateGroundPlane() {
+  const Map& map = slam_.map();
+  if (map.num_points() < 30 || map.keyframes().empty()) return;
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(map.num_points());
+  std::vector<int64_t> ids;
+  for (const auto& kv : map.points()) ids.push_back(kv.first);
+  std::sort(ids.begin(), ids.end());  // deterministic RANSAC input order
+  for (int64_t id : ids) points.push_back(map.point(id)->position);
+  // Up: minus the first keyframe camera's y axis (cameras are held roughly level).
+  const Rigid3d& first = map.keyframes().begin()->second.cam_from_world;
+  const Eigen::Vector3d up = -(first.RotationMatrix().transpose() * Eigen::Vector3d::UnitY());
+  GroundPlaneEstimate estimate;
+  if (EstimateGroundPlane(points, up, options_.ground, &estimate).ok() &&
+      estimate.inlier_ratio >= options_.ground_min_support) {
+    ground_ = estimate.plane;
+    MBSLAM_LOG(DEBUG) << "ground plane: n " << estimate.plane.normal.transpose() << " d " << estimate.plane.offset
+                      << ", inliers " << estimate.num_inliers << " (" << estimate.inlier_ratio << "), rms " << estimate.rms;
+  }
+}
+
+DepthBound PerceptionCore::DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const {
+  DepthBound bound = slam_.DepthBoundFor(track_id, xy, frame);
+  if (!ground_) return bound;
+  const std::optional<Rigid3d> cam_from_world = slam_.PoseOfFrame(frame);
+  if (!cam_from_world) return bound;
+  // A static point lies on or above the ground: along a ray that meets the ground in
+  // front of the camera, its depth is at most where the ray meets it (thesis 5.1.1:
+  // the ground plane cue; here it bounds the flow vector of sec. 3.5.2).
+  const Rigid3d world_from_cam = cam_from_world->Inverse();
+  const Eigen::Vector3d c = world_from_cam.translation;
+  const Eigen::Vector3d d = world_from_cam.rotation * xy.homogeneous();  // depth 1 along the ray
+  const double nd = ground_->normal.dot(d);
+  // Elevation of the ray below the horizon: near the horizon a small error of the
+  // plane's tilt moves the intersection far, so the margin grows as the angle shrinks.
+  const double elevation = std::asin(std::clamp(-nd / d.norm(), -1.0, 1.0));
+  const double min_elevation = options_.ground_min_elevation_deg * M_PI / 180.0;
+  if (elevation < min_elevation) return bound;
+  const double z_ground = -ground_->Height(c) / nd;
+  if (z_ground <= 0.0) return bound;
+  const double tilt = options_.ground_tilt_sigma_deg * M_PI / 180.0;
+  const double cap = z_ground * (1.0 + options_.ground_depth_margin + tilt / std::tan(elevation));
+  bound.z_max = std::min(bound.z_max, cap);
+  if (bound.z_min > bound.z_max) bound.z_min = 0.0;  // the map point itself is below ground: not trusted
+  return bound;
+}
+
 MapOutput PerceptionCore::BuildMapOutput(int64_t utime) const {
   MapOutput m;
   m.utime = utime;
@@ -136,6 +184,7 @@ MapOutput PerceptionCore::BuildMapOutput(int64_t utime) const {
     kf.num_observations = static_cast<int>(k.point_ids.size());
     m.keyframes.push_back(kf);
   }
+  if (ground_) m.ground_plane = ground_->ToVector4();
   return m;
 }
 
@@ -246,7 +295,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     };
     if (slam_.initialized()) {
       in.depth_bound = [this](int64_t id, const Eigen::Vector2d& xy, int64_t r) {
-        return slam_.DepthBoundFor(id, xy, r);
+        return DepthBoundFor(id, xy, r);
       };
     } else if (options_.odometry.use_for_ego_motion && !odometry_.empty()) {
       const double zmin = options_.odometry.min_depth_m;
@@ -286,6 +335,8 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       map_update = slam_.UpdateMap(slam_frame, all_static);
     }
   }
+  if (map_update.new_keyframe) UpdateGroundPlane();
+  if (map_update.rescaled_by && ground_) ground_->Rescale(*map_update.rescaled_by);
   FillCameraPose(slam_pose, &result.camera_pose);
   result.world_rescaled_by = map_update.rescaled_by;
   if (map_update.rescaled_by && result.camera_pose.tracking_state != TrackingState::kNotInitialized) {

@@ -15,6 +15,7 @@
 
 #include "common/config/options.h"
 #include "services/perception/geometry/pose_buffer.h"
+#include "services/perception/objects/ground_plane.h"
 #include "services/perception/pipeline/counters.h"
 #include "services/perception/pipeline/frame_processor.h"
 #include "services/perception/pipeline/stage_timers.h"
@@ -96,7 +97,12 @@ struct CoreOptions {
   PersonDetectorOptions person;
   OdometryOptions odometry;
   SlamOptions slam;
+  GroundPlaneOptions ground;
   int map_publish_every_frames = 15;  // PERCEPTION_MAP at most this often, and at every keyframe
+  double ground_depth_margin = 0.15;  // depth bound from the ground: static points lie above it (fraction)
+  double ground_min_elevation_deg = 3.0;  // rays closer to the horizon get no ground bound (deg)
+  double ground_tilt_sigma_deg = 2.0;     // assumed error of the plane's tilt, widening the bound near the horizon (deg)
+  double ground_min_support = 0.3;        // a plane is used only if this share of the map points lies on it
 };
 
 class PerceptionCore : public FrameProcessor {
@@ -114,6 +120,9 @@ class PerceptionCore : public FrameProcessor {
   std::optional<RelativeMotion> OdometryMotion(int64_t ref_frame, int64_t cur_frame) const;
   std::optional<Rigid3d> OdometryCameraPose(int64_t utime) const;
   void FillCameraPose(const SlamPose& pose, CameraPoseOutput* out) const;
+  void UpdateGroundPlane();
+  // SLAM's depth bound of a track, capped by where its ray meets the ground.
+  DepthBound DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const;
   MapOutput BuildMapOutput(int64_t utime) const;
   void Reset();
 
@@ -130,6 +139,7 @@ class PerceptionCore : public FrameProcessor {
   MotionSegmenter segmenter_;
   PersonDetector person_detector_;
   SlamSystem slam_;
+  std::optional<GroundPlane> ground_;
   int64_t last_map_publish_frame_ = -1000000;
   std::vector<cv::Mat> pyramid_;
   std::map<int64_t, int64_t> frame_utime_;   // frame index -> image time (recent frames)

@@ -123,9 +123,14 @@ void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
     if (pc.z() <= 1e-6) continue;
     const Eigen::Vector2d pred = K.Project(pc);
     if (!K.InImage(pred, margin)) continue;
+    // Behind a moving object: not visible, and its texture would fool the search.
+    const Eigen::Vector2f xy_pred = pc.hnormalized().cast<float>();
+    bool occluded = false;
+    for (const auto& hull : frame.moving_hulls_xy) occluded = occluded || InsideConvexHull(hull, xy_pred);
+    if (occluded) continue;
     ++searched;
     const PatchMatch m = FindPatchZssd(frame.image, p->patch, pred.cast<float>(), options_.guided_radius_px);
-    if (!m.found) continue;
+    if (!m.found || m.second < 1.5f * m.score) continue;  // ambiguous
     cv::Mat found;
     if (!ExtractPatch(frame.image, m.uv, p->patch.cols, &found) || PatchNcc(found, p->patch) < options_.guided_min_ncc) {
       continue;

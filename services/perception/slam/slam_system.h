@@ -204,6 +204,9 @@ class SlamSystem {
   // range of the map around its ray (the frustum), else [0, inf).
   DepthBound DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const;
 
+  // The current estimate of a recent image's pose (follows bundle adjustment).
+  std::optional<Rigid3d> PoseOfFrame(int64_t frame) const { return PoseOf(frame); }
+
   // Links a re-found map point to the track the tracker created for it.
   void AssociateTrack(int64_t point_id, int64_t track_id) { map_.AssociateTrack(point_id, track_id); }
 
