@@ -19,7 +19,7 @@ struct Rgb {
 // 3D view.
 constexpr Rgb kCameraTrajectoryColor{220, 20, 20};  // red
 constexpr Rgb kCurrentCameraColor{200, 0, 0};       // red, thicker frustum
-constexpr Rgb kKeyframeColor{80, 80, 80};            // dark grey
+constexpr Rgb kKeyframeColor{80, 80, 80};           // dark grey
 constexpr Rgb kParticleColor{0, 190, 0};            // green
 constexpr Rgb kGridColor{200, 200, 200};            // light grey
 

@@ -17,8 +17,18 @@ namespace viewer {
 // when utime < 0.
 std::string SnapshotPath(const std::string& prefix, const std::string& view, int64_t utime);
 
-// Encodes `bgr` as PNG and writes it atomically (temporary file, fsync, rename), after
-// creating the parent directory if needed.
+// PNG file bytes of a BGR image (fast zlib level: snapshots are written often).
+Status EncodePng(const cv::Mat& bgr, std::string* png);
+
+// Writes file bytes atomically (temporary file, fsync, rename), after creating the
+// parent directory if needed.
+Status WriteBytesAtomically(const std::string& path, const std::string& bytes);
+
+// Makes `path` another name of the existing file `target` (hard link to a temporary
+// name, renamed over `path`): the "latest" copy of a snapshot without writing it twice.
+Status LinkAtomically(const std::string& target, const std::string& path);
+
+// EncodePng + WriteBytesAtomically.
 Status WritePngAtomically(const std::string& path, const cv::Mat& bgr);
 
 // Where the files of a snapshot request go. An empty request prefix means

@@ -50,7 +50,8 @@ class ViewerApp {
   const ViewerLcmAdapter& adapter() const { return *adapter_; }
   int64_t snapshots_3d() const { return snapshots_3d_; }
   int64_t snapshots_image() const { return snapshots_image_; }
-  // Render times (ms): the first of each view and the run's summary.
+  // Render times (ms): the first of each view (shader compilation, JIT) and a summary of
+  // the later ones.
   double first_render_3d_ms() const { return first_render_3d_ms_; }
   TimingSummary render_3d_timing() const { return render_3d_ms_.Cumulative(); }
   TimingSummary render_image_timing() const { return render_image_ms_.Cumulative(); }
