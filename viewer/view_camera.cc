@@ -9,6 +9,8 @@ namespace viewer {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// Share of the picture's height the 3D view's header may cover (two lines at 720 px).
+constexpr double kHeaderFraction = 0.08;
 
 bool Finite(const Eigen::Vector3d& p) { return p.allFinite(); }
 
@@ -223,7 +225,14 @@ ViewCamera ComputeViewCamera(const View3dOptions& options, const SceneState& sce
       half_w = std::max(half_w, std::abs(c.x() - center_in_view.x()));
       half_h = std::max(half_h, std::abs(c.y() - center_in_view.y()));
     }
-    camera.ortho_half_height = std::max({half_h, half_w / aspect, 1e-6}) * 1.08;
+    // With the legend on, the top of the picture is the header's: the content goes below.
+    const double header = options.show_legend ? kHeaderFraction : 0.0;
+    const double content = std::max({half_h, half_w / aspect, 1e-6}) * 1.05;
+    camera.ortho_half_height = content / (1.0 - header);
+    const Eigen::Vector3d shift = screen_up * (header * camera.ortho_half_height);
+    const ViewCamera shifted =
+        LookAt(center + up * (2.0 * radius + 1e-6) + shift, center + shift, screen_up);
+    camera.view_from_world = shifted.view_from_world;
   } else {  // follow, or an overview while there is no camera pose yet
     if (have_camera) {
       const Eigen::Vector3d c = current->world_from_cam.position;
