@@ -271,7 +271,7 @@ void RenderImageView(const ImageViewOptions& options, const ImageViewInput& inpu
   if (tracks) {
     std::snprintf(header, sizeof(header),
                   "image view  t = %.3f s  frame %lld  |  static %d  moving %d  unassigned %d  "
-                  "occluded %d  |  %zu objects%s%s",
+                  "occluded %d  |  %zu object hulls%s%s",
                   UtimeToSeconds(input.utime), static_cast<long long>(tracks->frame_seq), counts[0],
                   counts[1], counts[2], counts[3], tracks->hulls.size(),
                   input.note.empty() ? "" : "  |  ", input.note.c_str());
