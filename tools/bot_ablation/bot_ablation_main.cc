@@ -8,13 +8,13 @@
 //   mbslam-bot-ablation [--out DIR] [--seeds N] [--camera handheld|car] [--wiggle S]
 //                       [--particles N] [--duration S]
 
+#include <sys/stat.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
-#include <sys/stat.h>
 #include <utility>
 #include <vector>
 
@@ -63,8 +63,8 @@ struct Curves {
   std::vector<double> depth_true;                // [frame] (m), first seed
 };
 
-bool RunScenario(BotSimCamera camera, BotSimTarget target, double wiggle, int seeds,
-                 int particles, double duration, const std::vector<CueSet>& sets, Curves* out) {
+bool RunScenario(BotSimCamera camera, BotSimTarget target, double wiggle, int seeds, int particles,
+                 double duration, const std::vector<CueSet>& sets, Curves* out) {
   const size_t n_sets = sets.size();
   out->depth_sigma.assign(n_sets, {});
   out->pos_err_rel_2s.assign(n_sets, 0.0);
@@ -162,15 +162,15 @@ void DrawPanel(cv::Mat* image, const cv::Rect& area, const std::string& title, c
     cv::line(*image, cv::Point(left, py(v)), cv::Point(right, py(v)), grid, 1);
     char buf[16];
     std::snprintf(buf, sizeof(buf), "%g", v);
-    cv::putText(*image, buf, cv::Point(left - 45, py(v) + 4), cv::FONT_HERSHEY_SIMPLEX, 0.4, ink,
-                1, cv::LINE_AA);
+    cv::putText(*image, buf, cv::Point(left - 45, py(v) + 4), cv::FONT_HERSHEY_SIMPLEX, 0.4, ink, 1,
+                cv::LINE_AA);
   }
   for (double t = 0.0; t <= duration + 1e-9; t += 0.5) {
     cv::line(*image, cv::Point(px(t), top), cv::Point(px(t), bottom), grid, 1);
     char buf[16];
     std::snprintf(buf, sizeof(buf), "%.1f", t);
-    cv::putText(*image, buf, cv::Point(px(t) - 10, bottom + 16), cv::FONT_HERSHEY_SIMPLEX, 0.4,
-                ink, 1, cv::LINE_AA);
+    cv::putText(*image, buf, cv::Point(px(t) - 10, bottom + 16), cv::FONT_HERSHEY_SIMPLEX, 0.4, ink,
+                1, cv::LINE_AA);
   }
   cv::rectangle(*image, cv::Point(left, top), cv::Point(right, bottom), ink, 1);
   cv::putText(*image, title, cv::Point(left, area.y + 25), cv::FONT_HERSHEY_SIMPLEX, 0.55, ink, 1,
@@ -187,7 +187,8 @@ void DrawPanel(cv::Mat* image, const cv::Rect& area, const std::string& title, c
   // Legend, top right.
   for (size_t k = 0; k < sets.size(); ++k) {
     const int y = top + 16 + 18 * static_cast<int>(k);
-    cv::line(*image, cv::Point(right - 170, y - 4), cv::Point(right - 145, y - 4), sets[k].color, 3);
+    cv::line(*image, cv::Point(right - 170, y - 4), cv::Point(right - 145, y - 4), sets[k].color,
+             3);
     cv::putText(*image, sets[k].label, cv::Point(right - 138, y), cv::FONT_HERSHEY_SIMPLEX, 0.42,
                 ink, 1, cv::LINE_AA);
   }
@@ -237,15 +238,18 @@ int Run(int argc, char** argv) {
   }
   if (seeds < 1 || particles < 10 || duration < 2.0 || wiggle < 0.0 ||
       (camera_name != "handheld" && camera_name != "car")) {
-    std::fprintf(stderr, "mbslam-bot-ablation: bad arguments (seeds >= 1, particles >= 10, "
-                         "duration >= 2 s, wiggle >= 0, camera handheld|car)\n");
+    std::fprintf(stderr,
+                 "mbslam-bot-ablation: bad arguments (seeds >= 1, particles >= 10, "
+                 "duration >= 2 s, wiggle >= 0, camera handheld|car)\n");
     return 2;
   }
   const BotSimCamera camera = camera_name == "car" ? BotSimCamera::kCar : BotSimCamera::kHandHeld;
   const std::vector<CueSet> sets = CueSets();
 
-  std::printf("bearing-only tracking cue ablation (thesis fig. 6.6): %s camera (wiggle x%.2g), "
-              "%d seeds, %d particles\n", camera_name.c_str(), wiggle, seeds, particles);
+  std::printf(
+      "bearing-only tracking cue ablation (thesis fig. 6.6): %s camera (wiggle x%.2g), "
+      "%d seeds, %d particles\n",
+      camera_name.c_str(), wiggle, seeds, particles);
   Curves following, crossing;
   if (!RunScenario(camera, BotSimTarget::kFollowing, wiggle, seeds, particles, duration, sets,
                    &following) ||
@@ -256,10 +260,11 @@ int Run(int argc, char** argv) {
   PrintTable("following", following, sets, duration);
   PrintTable("crossing", crossing, sets, duration);
   const size_t all = sets.size() - 1, sfm = sets.size() - 2;
-  std::printf("\nall cues: predicted volumes hold the true centre at +0.5 s in %.1f / %.1f %% "
-              "(following / crossing), at +1 s in %.1f / %.1f %%\n",
-              100.0 * following.hits_05[all], 100.0 * crossing.hits_05[all],
-              100.0 * following.hits_1[all], 100.0 * crossing.hits_1[all]);
+  std::printf(
+      "\nall cues: predicted volumes hold the true centre at +0.5 s in %.1f / %.1f %% "
+      "(following / crossing), at +1 s in %.1f / %.1f %%\n",
+      100.0 * following.hits_05[all], 100.0 * crossing.hits_05[all], 100.0 * following.hits_1[all],
+      100.0 * crossing.hits_1[all]);
   std::printf("relative scale error at 2 s: all cues %.1f / %.1f %%, SfM only %.1f / %.1f %%\n",
               100.0 * following.scale_err_2s[all], 100.0 * crossing.scale_err_2s[all],
               100.0 * following.scale_err_2s[sfm], 100.0 * crossing.scale_err_2s[sfm]);

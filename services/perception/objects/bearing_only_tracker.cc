@@ -41,6 +41,26 @@ uint64_t MixSeed(int64_t seed, int64_t object_id) {
   return x;
 }
 
+// Unit quaternion of the rotation vector w (rad); first order below 1e-4 rad.
+Eigen::Quaterniond QuaternionExp(const Eigen::Vector3d& w) {
+  const double theta = w.norm();
+  if (theta < 1e-4)
+    return Eigen::Quaterniond(1.0, 0.5 * w.x(), 0.5 * w.y(), 0.5 * w.z()).normalized();
+  const double half = 0.5 * theta;
+  const Eigen::Vector3d v = (std::sin(half) / theta) * w;
+  return Eigen::Quaterniond(std::cos(half), v.x(), v.y(), v.z());
+}
+
+// Translation of exp([u; w]) for the rotation vector w and u = v dt: J_l(w) u, by its
+// series I + W/2 + W^2/6 below 0.1 rad (relative error below 1e-4 there).
+Eigen::Vector3d StepTranslation(const Eigen::Vector3d& w, const Eigen::Vector3d& u) {
+  if (w.squaredNorm() < 1e-2) {
+    const Eigen::Vector3d wu = w.cross(u);
+    return u + 0.5 * wu + w.cross(wu) / 6.0;
+  }
+  return LeftJacobianSO3(w) * u;
+}
+
 bool FiniteGroundPlane(const std::optional<GroundPlane>& plane) {
   return plane && plane->IsValid();
 }
@@ -68,8 +88,7 @@ struct BearingOnlyTracker::StepCues {
   double Depth(const Eigen::Vector3d& p) const { return R_cw.row(2).dot(p) + t_cw.z(); }
 };
 
-BearingOnlyTracker::BearingOnlyTracker(const BearingOnlyTrackerOptions& options,
-                                       int64_t object_id)
+BearingOnlyTracker::BearingOnlyTracker(const BearingOnlyTrackerOptions& options, int64_t object_id)
     : options_(options),
       options_ok_(options.Check()),
       object_id_(object_id),
@@ -189,8 +208,8 @@ void BearingOnlyTracker::DrawInitialVelocity(BotParticle* particle, const StepCu
   Eigen::Vector3d direction = Normal3(&rng_);
   if (c.ground) direction = InPlane(direction, c.plane.normal);
   const double n = direction.norm();
-  particle->linear_velocity = n > 1e-12 ? Eigen::Vector3d(speed * direction / n)
-                                        : Eigen::Vector3d::Zero();
+  particle->linear_velocity =
+      n > 1e-12 ? Eigen::Vector3d(speed * direction / n) : Eigen::Vector3d::Zero();
   particle->angular_velocity.setZero();
 }
 
@@ -246,7 +265,8 @@ Status BearingOnlyTracker::InitializeImpl(const BotObservation& o,
   for (BotParticle& p : particles_) {
     bool ok = false;
     for (int attempt = 0; attempt < options_.max_rejection_tries && !ok; ++attempt) {
-      double z = point_in_world != nullptr ? rng_.Normal(z_mean, z_sigma) : rng_.Uniform(z_lo, z_hi);
+      double z =
+          point_in_world != nullptr ? rng_.Normal(z_mean, z_sigma) : rng_.Uniform(z_lo, z_hi);
       z = std::max(z, options_.min_depth);
       p.position = center + z * ray;
       p.ground_height = cues.has_plane ? cues.plane.Height(p.position) : 0.0;
@@ -313,10 +333,9 @@ void BearingOnlyTracker::Propagate(double dt, const StepCues& c,
         if (orientation_tracked_) {
           candidate.angular_velocity += sw * Normal3(&rng_);
           const Eigen::Vector3d wdt = candidate.angular_velocity * dt;
-          candidate.position += LeftJacobianSO3(wdt) * candidate.linear_velocity * dt + jitter;
+          candidate.position += StepTranslation(wdt, candidate.linear_velocity * dt) + jitter;
           candidate.rotation =
-              Eigen::Quaterniond(ExpSO3(sr * Normal3(&rng_)) * ExpSO3(wdt) *
-                                 candidate.rotation.toRotationMatrix())
+              (QuaternionExp(sr * Normal3(&rng_)) * QuaternionExp(wdt) * candidate.rotation)
                   .normalized();
         } else {
           candidate.position += candidate.linear_velocity * dt + jitter;
@@ -432,7 +451,8 @@ void BearingOnlyTracker::SeatVelocities(const BotObservation& o, const StepCues&
           const double speed = (v - v_n * n).norm();
           if (speed >= s_min && speed <= s_max) {
             const double sigma_h = std::sqrt(c.height_tolerance * c.height_tolerance +
-                                             eta * eta * (z1 * z1 + zk * zk)) / dt;
+                                             eta * eta * (z1 * z1 + zk * zk)) /
+                                   dt;
             density = std::exp(-0.5 * v_n * v_n / (sigma_h * sigma_h)) / sigma_h;
           }
         } else {
@@ -550,8 +570,8 @@ void BearingOnlyTracker::SfmStep(const BotObservation& o, double dt, const StepC
     const double s = p.sfm_scale;
     // Predict.
     Eigen::Vector3d position = p.position + p.linear_velocity * dt;
-    const double pp = p.kf_pp + 2.0 * dt * p.kf_pv + dt * dt * p.kf_vv + qa2 * dt * dt * dt / 3.0 +
-                      qp2 * dt;
+    const double pp =
+        p.kf_pp + 2.0 * dt * p.kf_pv + dt * dt * p.kf_vv + qa2 * dt * dt * dt / 3.0 + qp2 * dt;
     const double pv = p.kf_pv + dt * p.kf_vv + 0.5 * qa2 * dt * dt;
     const double vv = p.kf_vv + qa2 * dt;
     // Update with the SfM-implied position.
@@ -607,7 +627,8 @@ void BearingOnlyTracker::RecordSfm(const BotObservation& o) {
   if (ref != nullptr) {
     const double dt = static_cast<double>(o.utime - ref->utime) * kUsToS;
     w = LogSO3((now.world_from_obj_rotation * ref->world_from_obj_rotation.conjugate())
-                   .toRotationMatrix()) / dt;
+                   .toRotationMatrix()) /
+        dt;
   }
   const Eigen::Matrix3d R_cw = o.cam_from_world.RotationMatrix();
   const Eigen::Vector3d t_cw = o.cam_from_world.translation;
@@ -696,8 +717,7 @@ void BearingOnlyTracker::RegularizeDepths(const StepCues& cues) {
   cov /= static_cast<double>(n);
   Eigen::SelfAdjointEigenSolver<Matrix4> eig(cov);
   if (eig.info() != Eigen::Success) return;
-  const Matrix4 L =
-      eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+  const Matrix4 L = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
   // Silverman's bandwidth for four dimensions, scaled by the option.
   const double h = std::min(0.9, options_.depth_regularization * std::pow(4.0 / 6.0, 1.0 / 8.0) *
                                      std::pow(static_cast<double>(n), -1.0 / 8.0));
@@ -753,6 +773,7 @@ Status BearingOnlyTracker::Update(const BotObservation& o) {
 
   std::vector<double> truncation;
   if (SfmUsable(o)) {
+    ++stats_.sfm_steps;
     SfmStep(o, dt, cues, &truncation);
   } else {
     Propagate(dt, cues, &truncation);
@@ -843,9 +864,16 @@ BotEstimate BearingOnlyTracker::Estimate() const {
     const BotParticle& p = particles_[i];
     Vector6d d;
     d.head<3>() = p.position - mean_p;
-    d.tail<3>() = orientation_tracked_
-                      ? LogSO3((p.rotation * mean_q.conjugate()).toRotationMatrix())
-                      : Eigen::Vector3d::Zero();
+    if (orientation_tracked_) {
+      // Left perturbation of the rotation: 2 vec(q_i q_mean^-1) for the small spread
+      // among particles, the full logarithm beyond 0.1 rad.
+      Eigen::Quaterniond dq = p.rotation * mean_q.conjugate();
+      if (dq.w() < 0.0) dq.coeffs() = -dq.coeffs();
+      d.tail<3>() = dq.vec().squaredNorm() < 2.5e-3 ? Eigen::Vector3d(2.0 * dq.vec())
+                                                    : LogSO3(dq.toRotationMatrix());
+    } else {
+      d.tail<3>().setZero();
+    }
     pose_cov += w[i] * d * d.transpose();
     const Vector6d dv = p.twist() - mean_v;
     vel_cov += w[i] * dv * dv.transpose();
@@ -864,8 +892,8 @@ BotEstimate BearingOnlyTracker::Estimate() const {
   e.velocity_covariance = vel_cov;
   e.depth = mean_z;
   e.depth_sigma = std::sqrt(std::max(var_z, 0.0));
-  e.reliable = seated_ && mean_z > 0.0 &&
-               e.depth_sigma <= options_.reliable_depth_sigma_ratio * mean_z;
+  e.reliable =
+      seated_ && mean_z > 0.0 && e.depth_sigma <= options_.reliable_depth_sigma_ratio * mean_z;
   for (int i : SystematicIndices(options_.num_output_samples)) {
     e.particle_samples.push_back(particles_[static_cast<size_t>(i)].position.cast<float>());
   }
@@ -912,11 +940,11 @@ std::vector<PredictedVolume> BearingOnlyTracker::PredictVolumes(const ObjectExte
       const BotParticle& p = particles_[static_cast<size_t>(indices[k])];
       // Before the velocities are seated the motion is unknown: the prior speeds apply.
       Eigen::Vector3d step = p.linear_velocity * tau;
-      if (orientation_tracked_) step = LeftJacobianSO3(p.angular_velocity * tau) * step;
+      if (orientation_tracked_) step = StepTranslation(p.angular_velocity * tau, step);
       centers[k] = p.position + step;
     }
-    PredictedVolume v = BoundingVolume(centers, up, extent, vo.probability,
-                                       0.5 * vo.accel_margin * tau * tau);
+    PredictedVolume v =
+        BoundingVolume(centers, up, extent, vo.probability, 0.5 * vo.accel_margin * tau * tau);
     v.utime = utime_ + h;
     v.horizon_us = h;
     volumes.push_back(v);

@@ -103,45 +103,53 @@ struct BotCues {
 };
 
 struct BearingOnlyTrackerOptions {
-  int num_particles = 1000;                 // particles per object (count)
+  int num_particles = 1000;  // particles per object (count)
   // Initialisation (sec. 5.1.2).
-  double init_depth_min = 1.0;              // depth range along the ray without a depth bound (units)
-  double init_depth_max = 60.0;             // (units)
-  double init_speed_min = 0.0;              // velocity prior: uniform, speeds in [min, max] (units/s)
-  double init_speed_max = 15.0;             // (units/s)
-  int64_t init_velocity_baseline_us = 300000;  // velocities are seated at the first bearing this much later (µs)
-  double static_depth_sigma_ratio = 0.05;   // previously static object: depth sigma / depth when not given
+  double init_depth_min = 1.0;   // depth range along the ray without a depth bound (units)
+  double init_depth_max = 60.0;  // (units)
+  double init_speed_min = 0.0;   // velocity prior: uniform, speeds in [min, max] (units/s)
+  double init_speed_max = 15.0;  // (units/s)
+  int64_t init_velocity_baseline_us =
+      300000;  // velocities are seated at the first bearing this much later (µs)
+  double static_depth_sigma_ratio =
+      0.05;  // previously static object: depth sigma / depth when not given
   // Motion model (eq. 5.1).
-  double accel_sigma = 0.5;                 // white-noise linear acceleration (units/s^1.5)
-  double angular_accel_sigma = 0.1;         // white-noise angular acceleration (rad/s^1.5)
-  double position_sigma = 0.03;             // pose jitter, translation (units/s^0.5)
-  double rotation_sigma = 0.01;             // pose jitter, rotation (rad/s^0.5)
+  double accel_sigma = 0.5;          // white-noise linear acceleration (units/s^1.5)
+  double angular_accel_sigma = 0.1;  // white-noise angular acceleration (rad/s^1.5)
+  double position_sigma = 0.03;      // pose jitter, translation (units/s^0.5)
+  double rotation_sigma = 0.01;      // pose jitter, rotation (rad/s^0.5)
   // Measurement (eq. 5.2).
-  double bearing_sigma_px = 2.0;            // eta: bearing noise of the reference point (px)
-  double min_depth = 0.2;                   // particles nearer than this to the camera are invalid (units)
-  double resample_ess_ratio = 0.5;          // resample when ESS < ratio * N (0, 1]
-  double depth_regularization = 1.0;        // after resampling, (log depth, velocity) kernel of this x Silverman's bandwidth (0 = off)
-  double lost_residual_px = 40.0;           // no particle this close to the bearing: particles move onto the ray (px)
+  double bearing_sigma_px = 2.0;    // eta: bearing noise of the reference point (px)
+  double min_depth = 0.2;           // particles nearer than this to the camera are invalid (units)
+  double resample_ess_ratio = 0.5;  // resample when ESS < ratio * N (0, 1]
+  double depth_regularization = 1.0;  // after resampling, (log depth, velocity) kernel of this x
+                                      // Silverman's bandwidth (0 = off)
+  double lost_residual_px =
+      40.0;  // no particle this close to the bearing: particles move onto the ray (px)
   // Truncated sampling (sec. 5.1.3).
-  int max_rejection_tries = 10;             // redraws to satisfy the cue set psi (count)
-  double violation_weight = 1e-3;           // weight factor of a particle still outside psi (0, 1]
+  int max_rejection_tries = 10;    // redraws to satisfy the cue set psi (count)
+  double violation_weight = 1e-3;  // weight factor of a particle still outside psi (0, 1]
   // Cues.
   BotCues cues;
-  double ground_height_tolerance = 0.15;    // ground plane: height change of the tracked point allowed (units)
-  double ground_height_sigma = 0.02;        // ground plane: vertical jitter of the tracked point (units/s^0.5)
-  double below_ground_tolerance = 0.15;     // tracks may appear this far below the ground (units)
-  double max_ground_clearance = 0.6;        // size bound: lowest track at most this high above the ground (units)
-  double max_object_height = 4.0;           // size bound: object height at most (units)
-  double size_bound_percentile = 0.05;      // robust lowest / highest track: this percentile [0, 0.5)
-  int size_bound_min_tracks = 3;            // fewer tracks: no size bound in that image (count)
-  double sfm_sigma_ratio = 0.01;            // SfM position noise, fraction of the depth (ratio)
-  double sfm_scale_sigma = 0.01;            // random walk of each particle's log scale under SfM (1/s^0.5)
+  double ground_height_tolerance =
+      0.15;  // ground plane: height change of the tracked point allowed (units)
+  double ground_height_sigma =
+      0.02;  // ground plane: vertical jitter of the tracked point (units/s^0.5)
+  double below_ground_tolerance = 0.15;  // tracks may appear this far below the ground (units)
+  double max_ground_clearance =
+      0.6;  // size bound: lowest track at most this high above the ground (units)
+  double max_object_height = 4.0;       // size bound: object height at most (units)
+  double size_bound_percentile = 0.05;  // robust lowest / highest track: this percentile [0, 0.5)
+  int size_bound_min_tracks = 3;        // fewer tracks: no size bound in that image (count)
+  double sfm_sigma_ratio = 0.01;        // SfM position noise, fraction of the depth (ratio)
+  double sfm_scale_sigma = 0.01;  // random walk of each particle's log scale under SfM (1/s^0.5)
   int64_t sfm_velocity_baseline_us = 300000;  // SfM angular velocity over at least this time (µs)
   // Outputs.
-  int num_output_samples = 100;             // particle positions in the estimate (count)
-  double reliable_depth_sigma_ratio = 0.2;  // estimate reliable when depth sigma / depth below (ratio)
+  int num_output_samples = 100;  // particle positions in the estimate (count)
+  double reliable_depth_sigma_ratio =
+      0.2;  // estimate reliable when depth sigma / depth below (ratio)
   PredictedVolumeOptions volumes;
-  int64_t seed = 0;                         // mixed with the object id (deterministic)
+  int64_t seed = 0;  // mixed with the object id (deterministic)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(num_particles, 10);
@@ -198,22 +206,32 @@ struct BearingOnlyTrackerOptions {
     v("resample_ess_ratio", &resample_ess_ratio, "resample when ESS < ratio * N (0, 1]");
     v("depth_regularization", &depth_regularization,
       "(log depth, velocity) kernel after resampling, x Silverman's bandwidth (0 = off)");
-    v("lost_residual_px", &lost_residual_px, "no particle this close: particles move onto the ray (px)");
+    v("lost_residual_px", &lost_residual_px,
+      "no particle this close: particles move onto the ray (px)");
     v("max_rejection_tries", &max_rejection_tries, "redraws to satisfy the cue set (count)");
-    v("violation_weight", &violation_weight, "weight factor of a particle outside the cue set (0, 1]");
+    v("violation_weight", &violation_weight,
+      "weight factor of a particle outside the cue set (0, 1]");
     v("cues", &cues, "cue set psi");
-    v("ground_height_tolerance", &ground_height_tolerance, "height change allowed on the ground plane (units)");
-    v("ground_height_sigma", &ground_height_sigma, "vertical jitter on the ground plane (units/s^0.5)");
-    v("below_ground_tolerance", &below_ground_tolerance, "tracks may appear this far below the ground (units)");
-    v("max_ground_clearance", &max_ground_clearance, "lowest track at most this high above the ground (units)");
+    v("ground_height_tolerance", &ground_height_tolerance,
+      "height change allowed on the ground plane (units)");
+    v("ground_height_sigma", &ground_height_sigma,
+      "vertical jitter on the ground plane (units/s^0.5)");
+    v("below_ground_tolerance", &below_ground_tolerance,
+      "tracks may appear this far below the ground (units)");
+    v("max_ground_clearance", &max_ground_clearance,
+      "lowest track at most this high above the ground (units)");
     v("max_object_height", &max_object_height, "object height at most (units)");
-    v("size_bound_percentile", &size_bound_percentile, "robust lowest / highest track percentile [0, 0.5)");
+    v("size_bound_percentile", &size_bound_percentile,
+      "robust lowest / highest track percentile [0, 0.5)");
     v("size_bound_min_tracks", &size_bound_min_tracks, "fewer tracks: no size bound (count)");
     v("sfm_sigma_ratio", &sfm_sigma_ratio, "SfM position noise, fraction of the depth");
-    v("sfm_scale_sigma", &sfm_scale_sigma, "random walk of each particle's log scale under SfM (1/s^0.5)");
-    v("sfm_velocity_baseline_us", &sfm_velocity_baseline_us, "SfM angular velocity over at least this time (us)");
+    v("sfm_scale_sigma", &sfm_scale_sigma,
+      "random walk of each particle's log scale under SfM (1/s^0.5)");
+    v("sfm_velocity_baseline_us", &sfm_velocity_baseline_us,
+      "SfM angular velocity over at least this time (us)");
     v("num_output_samples", &num_output_samples, "particle positions in the estimate (count)");
-    v("reliable_depth_sigma_ratio", &reliable_depth_sigma_ratio, "reliable when depth sigma / depth below");
+    v("reliable_depth_sigma_ratio", &reliable_depth_sigma_ratio,
+      "reliable when depth sigma / depth below");
     v("volumes", &volumes, "predicted volumes");
     v("seed", &seed, "mixed with the object id");
   }
@@ -236,25 +254,27 @@ struct SfmObservation {
 
 // One image's evidence about one object.
 struct BotObservation {
-  int64_t utime = 0;                             // image time (µs)
-  Rigid3d cam_from_world;                        // static SLAM pose of this image
-  double focal_px = 0.0;                         // focal length: pixel sigmas -> normalised (px)
-  Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // bearing of the reference point (normalised, undistorted)
-  double bearing_sigma_px = 0.0;                 // > 0 overrides options.bearing_sigma_px (px)
-  std::vector<Eigen::Vector2d> track_xy;         // the object's tracks (normalised): size bound, extent
-  std::optional<DepthRange> depth_bound;         // static map depths along this ray (depth-bound cue)
-  std::optional<GroundPlane> ground_plane;       // static map's ground (ground-plane and size-bound cues)
-  std::optional<SfmObservation> sfm;             // the object's reconstruction (SfM feedback)
+  int64_t utime = 0;       // image time (µs)
+  Rigid3d cam_from_world;  // static SLAM pose of this image
+  double focal_px = 0.0;   // focal length: pixel sigmas -> normalised (px)
+  Eigen::Vector2d xy =
+      Eigen::Vector2d::Zero();    // bearing of the reference point (normalised, undistorted)
+  double bearing_sigma_px = 0.0;  // > 0 overrides options.bearing_sigma_px (px)
+  std::vector<Eigen::Vector2d> track_xy;  // the object's tracks (normalised): size bound, extent
+  std::optional<DepthRange> depth_bound;  // static map depths along this ray (depth-bound cue)
+  std::optional<GroundPlane>
+      ground_plane;                   // static map's ground (ground-plane and size-bound cues)
+  std::optional<SfmObservation> sfm;  // the object's reconstruction (SfM feedback)
 };
 
 struct BotParticle {
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // tracked point, world (units)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();            // tracked point, world (units)
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();  // world_from_particle rotation
-  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   // v, world axes (units/s)
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // w, world axes (rad/s)
-  double log_weight = 0.0;    // normalised: sum of exp = 1
-  double ground_height = 0.0; // height above the ground kept by the ground-plane cue (units)
-  double sfm_scale = 0.0;     // s_i = d_i / d_SfM (world units per object map unit), 0 if none
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();     // v, world axes (units/s)
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();    // w, world axes (rad/s)
+  double log_weight = 0.0;                                       // normalised: sum of exp = 1
+  double ground_height = 0.0;  // height above the ground kept by the ground-plane cue (units)
+  double sfm_scale = 0.0;      // s_i = d_i / d_SfM (world units per object map unit), 0 if none
   // Under SfM feedback: per-axis covariance of (position, velocity) of the particle's
   // Kalman filter on the SfM-implied positions (units^2, units^2/s, units^2/s^2).
   double kf_pp = 0.0, kf_pv = 0.0, kf_vv = 0.0;
@@ -284,16 +304,17 @@ struct BotEstimate {
   double depth_sigma = 0.0;  // (units)
   double effective_sample_size = 0.0;
   int num_particles = 0;
-  std::vector<Eigen::Vector3f> particle_samples;  // deterministic weighted subsample (units)
+  std::vector<Eigen::Vector3f> particle_samples;        // deterministic weighted subsample (units)
   std::optional<RelativeScaleEstimate> relative_scale;  // from the SfM feedback (sec. 6.1)
 };
 
 struct BotStats {
   int64_t updates = 0;
-  int64_t predictions = 0;       // steps without a bearing
+  int64_t predictions = 0;  // steps without a bearing
+  int64_t sfm_steps = 0;    // updates that used the object's reconstruction
   int64_t resamplings = 0;
-  int64_t recoveries = 0;        // bearing far from every particle: moved onto the ray
-  int64_t rejected_inputs = 0;   // observations refused (bad input, time backwards)
+  int64_t recoveries = 0;             // bearing far from every particle: moved onto the ray
+  int64_t rejected_inputs = 0;        // observations refused (bad input, time backwards)
   double last_violation_share = 0.0;  // particles outside psi after the last step [0, 1]
   double last_ess = 0.0;
 };

@@ -14,17 +14,17 @@ constexpr double kFarWallX = 90.0;  // end of the street (m)
 constexpr double kWallHeight = 10.0;
 
 struct CameraScenario {
-  double height;   // (m)
-  double speed;    // mean forward speed (m/s)
-  double surge;    // forward speed variation amplitude (m/s)
+  double height;  // (m)
+  double speed;   // mean forward speed (m/s)
+  double surge;   // forward speed variation amplitude (m/s)
   double surge_hz;
-  double bob;      // vertical amplitude (m)
+  double bob;  // vertical amplitude (m)
   double bob_hz;
-  double sway;     // lateral amplitude (m)
+  double sway;  // lateral amplitude (m)
   double sway_hz;
-  double pitch;    // (rad)
-  double yaw;      // (rad)
-  double roll;     // (rad)
+  double pitch;  // (rad)
+  double yaw;    // (rad)
+  double roll;   // (rad)
 };
 
 struct TargetScenario {
@@ -45,7 +45,8 @@ CameraScenario CameraFor(BotSimCamera camera) {
 TargetScenario TargetFor(BotSimCamera camera, BotSimTarget target) {
   if (camera == BotSimCamera::kCar) {
     if (target == BotSimTarget::kFollowing) {
-      return {Eigen::Vector3d(4.2, 1.8, 1.5), Eigen::Vector2d(17.0, 0.3), Eigen::Vector2d(5.0, 0.0)};
+      return {Eigen::Vector3d(4.2, 1.8, 1.5), Eigen::Vector2d(17.0, 0.3),
+              Eigen::Vector2d(5.0, 0.0)};
     }
     return {Eigen::Vector3d(4.2, 1.8, 1.5), Eigen::Vector2d(26.0, 7.0), Eigen::Vector2d(0.0, -4.0)};
   }
@@ -100,11 +101,21 @@ std::vector<SurfacePoint> BoxSurfacePoints(const Eigen::Vector3d& size, int coun
     const double a = rng->Uniform(-0.5, 0.5), b = rng->Uniform(-0.5, 0.5);
     SurfacePoint p;
     switch (face) {
-      case 0: p = {Eigen::Vector3d(0.5 * L, a * W, b * H), Eigen::Vector3d::UnitX()}; break;
-      case 1: p = {Eigen::Vector3d(-0.5 * L, a * W, b * H), -Eigen::Vector3d::UnitX()}; break;
-      case 2: p = {Eigen::Vector3d(a * L, 0.5 * W, b * H), Eigen::Vector3d::UnitY()}; break;
-      case 3: p = {Eigen::Vector3d(a * L, -0.5 * W, b * H), -Eigen::Vector3d::UnitY()}; break;
-      default: p = {Eigen::Vector3d(a * L, b * W, 0.5 * H), Eigen::Vector3d::UnitZ()}; break;
+      case 0:
+        p = {Eigen::Vector3d(0.5 * L, a * W, b * H), Eigen::Vector3d::UnitX()};
+        break;
+      case 1:
+        p = {Eigen::Vector3d(-0.5 * L, a * W, b * H), -Eigen::Vector3d::UnitX()};
+        break;
+      case 2:
+        p = {Eigen::Vector3d(a * L, 0.5 * W, b * H), Eigen::Vector3d::UnitY()};
+        break;
+      case 3:
+        p = {Eigen::Vector3d(a * L, -0.5 * W, b * H), -Eigen::Vector3d::UnitY()};
+        break;
+      default:
+        p = {Eigen::Vector3d(a * L, b * W, 0.5 * H), Eigen::Vector3d::UnitZ()};
+        break;
     }
     points.push_back(p);
   }
@@ -146,8 +157,8 @@ const char* BotSimTargetName(BotSimTarget target) {
 
 Status SimulateBotSequence(const BotSimOptions& o, BotSimSequence* sequence) {
   if (sequence == nullptr) return Status::Error("SimulateBotSequence: null output");
-  if (!(o.fps > 0.0) || !(o.duration_s > 0.0) || !(o.focal_px > 0.0) ||
-      o.num_target_points < 3 || !(o.sfm_relative_scale > 0.0)) {
+  if (!(o.fps > 0.0) || !(o.duration_s > 0.0) || !(o.focal_px > 0.0) || o.num_target_points < 3 ||
+      !(o.sfm_relative_scale > 0.0)) {
     return Status::Error("SimulateBotSequence: bad options");
   }
   ParticleRng rng(o.seed);
@@ -218,7 +229,10 @@ Status SimulateBotSequence(const BotSimOptions& o, BotSimSequence* sequence) {
     obs.cam_from_world = f.cam_from_world;
     obs.focal_px = o.focal_px;
     const Eigen::Vector3d ref_cam = f.cam_from_world * f.reference_in_world;
-    obs.xy = ref_cam.head<2>() / ref_cam.z() + Noise2(&rng, o.bearing_noise_px / o.focal_px);
+    const Eigen::Vector2d ref_xy = ref_cam.head<2>() / ref_cam.z();
+    f.visible = ref_cam.z() > 0.5 && std::abs(ref_xy.x()) * o.focal_px < 320.0 &&
+                std::abs(ref_xy.y()) * o.focal_px < 240.0;
+    obs.xy = ref_xy + Noise2(&rng, o.bearing_noise_px / o.focal_px);
     for (const SurfacePoint& p : points) {
       if (!Visible(p, f.world_from_target, world_from_cam.translation)) continue;
       const Eigen::Vector3d pc = f.cam_from_world * (f.world_from_target * p.position);
@@ -283,12 +297,15 @@ Status RunBotSequence(const BotSimSequence& sequence, const BearingOnlyTrackerOp
   for (size_t k = 0; k < sequence.frames.size(); ++k) {
     const BotSimFrame& f = sequence.frames[k];
     if (k == 0) {
+      if (!f.visible) return Status::Error("RunBotSequence: target not visible at the start");
       MBSLAM_RETURN_IF_ERROR(tracker.Initialize(f.observation));
-    } else {
+    } else if (f.visible) {
       MBSLAM_RETURN_IF_ERROR(tracker.Update(f.observation));
+    } else {
+      MBSLAM_RETURN_IF_ERROR(tracker.Predict(f.utime, f.observation.ground_plane));
     }
     const BotEstimate e = tracker.Estimate();
-    if (e.depth > 0.0) {
+    if (f.visible && e.depth > 0.0) {
       // Too few tracks just leave the extent as it was.
       static_cast<void>(extent.Update(f.cam_from_world, f.observation.track_xy, f.observation.xy,
                                       e.depth, sequence.ground_plane.plane.normal));

@@ -38,10 +38,11 @@ const char* BotSimTargetName(BotSimTarget target);
 struct BotSimOptions {
   BotSimCamera camera = BotSimCamera::kHandHeld;
   BotSimTarget target = BotSimTarget::kFollowing;
-  double wiggle_scale = 1.0;        // scales the camera's speed changes, bob, sway, rotations (0 = smooth)
-  double fps = 30.0;                // image rate (Hz)
-  double duration_s = 3.0;          // sequence length (s)
-  double focal_px = 500.0;          // pinhole focal length (px), 640 x 480 images
+  double wiggle_scale =
+      1.0;                  // scales the camera's speed changes, bob, sway, rotations (0 = smooth)
+  double fps = 30.0;        // image rate (Hz)
+  double duration_s = 3.0;  // sequence length (s)
+  double focal_px = 500.0;  // pinhole focal length (px), 640 x 480 images
   double bearing_noise_px = 1.0;    // noise of the reference bearing (px)
   double track_noise_px = 0.5;      // noise of each track (px)
   int num_target_points = 150;      // feature points on the target, seen when their face is (count)
@@ -49,28 +50,29 @@ struct BotSimOptions {
   double sfm_start_s = 0.5;         // the target's reconstruction exists from this time (s)
   double sfm_rotation_noise_rad = 0.002;       // per image (rad)
   double sfm_translation_noise_ratio = 0.002;  // per image, fraction of the distance
-  double depth_bound_near = 1.0;    // near end of the depth bound (m)
-  int num_static_points = 1500;     // static map points for the ground plane (count)
-  double static_outlier_ratio = 0.2;  // share of them that are random outliers
-  double ground_point_noise = 0.02;   // height noise of ground points (m)
+  double depth_bound_near = 1.0;               // near end of the depth bound (m)
+  int num_static_points = 1500;                // static map points for the ground plane (count)
+  double static_outlier_ratio = 0.2;           // share of them that are random outliers
+  double ground_point_noise = 0.02;            // height noise of ground points (m)
   uint64_t seed = 1;
 };
 
 struct BotSimFrame {
   int64_t utime = 0;
-  Rigid3d cam_from_world;                     // truth (and what the static SLAM would give)
-  Rigid3d world_from_target;                  // truth: target box centre and heading
+  Rigid3d cam_from_world;     // truth (and what the static SLAM would give)
+  Rigid3d world_from_target;  // truth: target box centre and heading
   Eigen::Vector3d reference_in_world = Eigen::Vector3d::Zero();  // truth: the tracked point
   Eigen::Vector3d target_velocity = Eigen::Vector3d::Zero();     // truth (m/s)
-  BotObservation observation;                 // what the tracker gets
+  bool visible = true;         // reference point in front of the camera and in the image
+  BotObservation observation;  // what the tracker gets (when visible)
 };
 
 struct BotSimSequence {
   BotSimOptions options;
   std::vector<BotSimFrame> frames;
   std::vector<Eigen::Vector3d> static_points;
-  GroundPlaneEstimate ground_plane;            // estimated from static_points
-  Eigen::Vector3d target_size = Eigen::Vector3d::Zero();  // length, width, height (m)
+  GroundPlaneEstimate ground_plane;                               // estimated from static_points
+  Eigen::Vector3d target_size = Eigen::Vector3d::Zero();          // length, width, height (m)
   Eigen::Vector3d reference_in_target = Eigen::Vector3d::Zero();  // (m)
 };
 
@@ -78,12 +80,12 @@ Status SimulateBotSequence(const BotSimOptions& options, BotSimSequence* sequenc
 
 // One tracker run over a sequence, scored against the truth.
 struct BotRunFrame {
-  double t_s = 0.0;            // since initialisation (s)
-  double depth_true = 0.0;     // camera depth of the reference point (m)
-  double depth_mean = 0.0;     // (m)
-  double depth_sigma = 0.0;    // (m)
+  double t_s = 0.0;             // since initialisation (s)
+  double depth_true = 0.0;      // camera depth of the reference point (m)
+  double depth_mean = 0.0;      // (m)
+  double depth_sigma = 0.0;     // (m)
   double position_error = 0.0;  // |estimate - truth| of the reference point (m)
-  double range = 0.0;          // distance camera - reference point (m)
+  double range = 0.0;           // distance camera - reference point (m)
   double ess = 0.0;
   bool reliable = false;
   std::optional<double> relative_scale;

@@ -94,8 +94,8 @@ Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
     const int c = static_cast<int>(rng.Uniform() * n);
     if (a == b || b == c || a == c) continue;
     const Eigen::Vector3d& pa = finite[static_cast<size_t>(a)];
-    Eigen::Vector3d normal = (finite[static_cast<size_t>(b)] - pa)
-                                 .cross(finite[static_cast<size_t>(c)] - pa);
+    Eigen::Vector3d normal =
+        (finite[static_cast<size_t>(b)] - pa).cross(finite[static_cast<size_t>(c)] - pa);
     const double norm = normal.norm();
     if (norm < 1e-12) continue;
     normal /= norm;

@@ -36,13 +36,13 @@ struct GroundPlane {
 };
 
 struct GroundPlaneOptions {
-  int max_iterations = 400;         // RANSAC hypotheses (count)
-  double inlier_threshold = 0.05;   // point-to-plane distance of an inlier (world units)
-  double max_tilt_deg = 25.0;       // angle between the normal and the up hint at most (deg)
-  int min_inliers = 20;             // fewer inliers: no plane (count)
-  double min_inlier_ratio = 0.05;   // ... or a smaller share of the points: no plane [0, 1]
-  int refine_iterations = 3;        // least-squares refits with re-selected inliers (count)
-  int64_t seed = 1;                 // RANSAC sampling seed (deterministic)
+  int max_iterations = 400;        // RANSAC hypotheses (count)
+  double inlier_threshold = 0.05;  // point-to-plane distance of an inlier (world units)
+  double max_tilt_deg = 25.0;      // angle between the normal and the up hint at most (deg)
+  int min_inliers = 20;            // fewer inliers: no plane (count)
+  double min_inlier_ratio = 0.05;  // ... or a smaller share of the points: no plane [0, 1]
+  int refine_iterations = 3;       // least-squares refits with re-selected inliers (count)
+  int64_t seed = 1;                // RANSAC sampling seed (deterministic)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(max_iterations, 0);

@@ -1,1 +1,101 @@
+#include "services/perception/objects/ground_plane.h"
+
 #include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <vector>
+
+#include "services/perception/objects/random.h"
+
+namespace mbslam {
+namespace {
+
+// A tilted ground (normal 3 deg off z), two facades, and uniform outliers.
+std::vector<Eigen::Vector3d> Scene(const GroundPlane& ground, double outlier_share, uint64_t seed) {
+  ParticleRng rng(seed);
+  std::vector<Eigen::Vector3d> points;
+  const Eigen::Vector3d u = ground.normal.unitOrthogonal();
+  const Eigen::Vector3d v = ground.normal.cross(u);
+  const Eigen::Vector3d origin = -ground.offset * ground.normal;
+  for (int i = 0; i < 600; ++i) {
+    points.push_back(origin + rng.Uniform(-20, 20) * u + rng.Uniform(-10, 10) * v +
+                     rng.Normal(0.0, 0.01) * ground.normal);
+  }
+  for (int i = 0; i < 400; ++i) {  // facades y = +-8 (more points than any wrong plane)
+    points.emplace_back(rng.Uniform(-20, 20), i % 2 ? 8.0 : -8.0, rng.Uniform(0, 8));
+  }
+  const int outliers = static_cast<int>(outlier_share * points.size() / (1.0 - outlier_share));
+  for (int i = 0; i < outliers; ++i) {
+    points.emplace_back(rng.Uniform(-20, 20), rng.Uniform(-8, 8), rng.Uniform(-2, 8));
+  }
+  return points;
+}
+
+TEST(GroundPlane, RansacFindsTiltedPlaneAmongFacadesAndOutliers) {
+  GroundPlane truth;
+  truth.normal =
+      Eigen::AngleAxisd(3.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()) * Eigen::Vector3d::UnitZ();
+  truth.offset = 1.5;  // the ground 1.5 units below the origin (a camera at the origin)
+  const std::vector<Eigen::Vector3d> points = Scene(truth, 0.3, 7);
+  GroundPlaneEstimate estimate;
+  // A rough up hint (10 deg off).
+  const Eigen::Vector3d up(0.0, 0.17, 1.0);
+  ASSERT_TRUE(EstimateGroundPlane(points, up, &estimate).ok());
+  EXPECT_LT(std::acos(std::min(1.0, estimate.plane.normal.dot(truth.normal))), 0.3 * M_PI / 180.0);
+  EXPECT_NEAR(estimate.plane.offset, truth.offset, 0.01);
+  EXPECT_GE(estimate.num_inliers, 590);
+  EXPECT_LT(estimate.num_inliers, 700);
+  EXPECT_LT(estimate.rms, 0.02);
+  EXPECT_NEAR(estimate.inlier_ratio, estimate.num_inliers / static_cast<double>(points.size()),
+              1e-12);
+  // The camera (origin) is above the ground.
+  EXPECT_NEAR(estimate.plane.Height(Eigen::Vector3d::Zero()), 1.5, 0.01);
+}
+
+TEST(GroundPlane, DeterministicForASeed) {
+  GroundPlane truth;
+  const std::vector<Eigen::Vector3d> points = Scene(truth, 0.5, 3);
+  GroundPlaneEstimate a, b;
+  ASSERT_TRUE(EstimateGroundPlane(points, Eigen::Vector3d::UnitZ(), &a).ok());
+  ASSERT_TRUE(EstimateGroundPlane(points, Eigen::Vector3d::UnitZ(), &b).ok());
+  EXPECT_EQ(a.plane.normal, b.plane.normal);
+  EXPECT_EQ(a.plane.offset, b.plane.offset);
+  EXPECT_EQ(a.num_inliers, b.num_inliers);
+}
+
+TEST(GroundPlane, RefusesBadInputAndScenesWithoutGround) {
+  GroundPlaneEstimate estimate;
+  EXPECT_FALSE(EstimateGroundPlane({}, Eigen::Vector3d::UnitZ(), &estimate).ok());
+  EXPECT_FALSE(EstimateGroundPlane({Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX()},
+                                   Eigen::Vector3d::UnitZ(), &estimate)
+                   .ok());
+  std::vector<Eigen::Vector3d> walls;
+  ParticleRng rng(1);
+  for (int i = 0; i < 200; ++i) walls.emplace_back(rng.Uniform(-5, 5), 3.0, rng.Uniform(0, 3));
+  EXPECT_FALSE(EstimateGroundPlane(walls, Eigen::Vector3d::Zero(), &estimate).ok());
+  // Only a vertical wall: no plane within the tilt limit.
+  EXPECT_FALSE(EstimateGroundPlane(walls, Eigen::Vector3d::UnitZ(), &estimate).ok());
+  GroundPlaneOptions bad;
+  bad.max_tilt_deg = 95.0;
+  EXPECT_FALSE(bad.Check());
+  EXPECT_FALSE(EstimateGroundPlane(walls, Eigen::Vector3d::UnitZ(), bad, &estimate).ok());
+}
+
+TEST(GroundPlane, Vector4RoundTripAndRescale) {
+  const std::optional<GroundPlane> g = GroundPlane::FromVector4(Eigen::Vector4d(0, 0, 2, 3));
+  ASSERT_TRUE(g);
+  EXPECT_TRUE(g->IsValid());
+  EXPECT_NEAR(g->normal.z(), 1.0, 1e-12);
+  EXPECT_NEAR(g->offset, 1.5, 1e-12);
+  EXPECT_TRUE(g->ToVector4().isApprox(Eigen::Vector4d(0, 0, 1, 1.5)));
+  EXPECT_FALSE(GroundPlane::FromVector4(Eigen::Vector4d::Zero()));
+  EXPECT_FALSE(GroundPlane::FromVector4(Eigen::Vector4d(0, 0, NAN, 1)));
+  GroundPlane h = *g;
+  h.Rescale(2.0);
+  EXPECT_NEAR(h.Height(Eigen::Vector3d(0, 0, 1)), 4.0, 1e-12);  // offset 1.5 -> 3
+}
+
+}  // namespace
+}  // namespace mbslam

@@ -46,8 +46,8 @@ struct ObjectExtentOptions {
   double depth_to_width_ratio = 1.0;  // unseen depth of the object / its width (ratio)
   double min_size = 0.2;              // each size at least (units)
   double max_size = 30.0;             // each size at most (units)
-  double smoothing = 0.3;             // exponential smoothing gain of a new image [0, 1] (1 = no memory)
-  int min_tracks = 3;                 // fewer tracks: the image is ignored (count)
+  double smoothing = 0.3;  // exponential smoothing gain of a new image [0, 1] (1 = no memory)
+  int min_tracks = 3;      // fewer tracks: the image is ignored (count)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION(low_percentile >= 0.0 && low_percentile < 0.5);

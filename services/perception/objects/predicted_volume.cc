@@ -13,8 +13,8 @@ constexpr double kMinScale = 1e-9;
 // Value at quantile q in [0, 1] of `values` (reorders them).
 double Quantile(std::vector<double>* values, double q) {
   const size_t n = values->size();
-  const size_t k = std::min(n - 1, static_cast<size_t>(std::ceil(q * static_cast<double>(n))) -
-                                       (q > 0.0 ? 1 : 0));
+  const size_t k = std::min(
+      n - 1, static_cast<size_t>(std::ceil(q * static_cast<double>(n))) - (q > 0.0 ? 1 : 0));
   std::nth_element(values->begin(), values->begin() + static_cast<std::ptrdiff_t>(k),
                    values->end());
   return (*values)[k];
@@ -68,8 +68,8 @@ bool PredictedVolume::Contains(const Eigen::Vector3d& point_in_world) const {
 }
 
 PredictedVolume BoundingVolume(const std::vector<Eigen::Vector3d>& centers,
-                               const std::optional<Eigen::Vector3d>& up,
-                               const ObjectExtent& extent, double probability, double margin) {
+                               const std::optional<Eigen::Vector3d>& up, const ObjectExtent& extent,
+                               double probability, double margin) {
   PredictedVolume volume;
   const size_t n = centers.size();
   if (n == 0) return volume;
@@ -105,8 +105,10 @@ PredictedVolume BoundingVolume(const std::vector<Eigen::Vector3d>& centers,
   size_t inside = 0;
   for (double x : radius) inside += x <= r ? 1 : 0;
 
-  const Eigen::Vector3d core = r * scale;
-  volume.center = mean + axes * mid + (extent.valid ? extent.center_offset : Eigen::Vector3d::Zero());
+  // (A hair wider, so that the particle on the boundary stays inside after rounding.)
+  const Eigen::Vector3d core = (r * (1.0 + 1e-9)) * scale;
+  volume.center =
+      mean + axes * mid + (extent.valid ? extent.center_offset : Eigen::Vector3d::Zero());
   volume.orientation = Eigen::Quaterniond(axes).normalized();
   volume.half_extent =
       core + extent.HalfSizeAlong(axes) + Eigen::Vector3d::Constant(std::max(margin, 0.0));

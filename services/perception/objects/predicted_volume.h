@@ -28,8 +28,8 @@
 namespace mbslam {
 
 struct PredictedVolume {
-  int64_t utime = 0;       // time the prediction is for (µs)
-  int64_t horizon_us = 0;  // utime minus the time of the estimate (µs)
+  int64_t utime = 0;                                 // time the prediction is for (µs)
+  int64_t horizon_us = 0;                            // utime minus the time of the estimate (µs)
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // box centre, world (units)
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // world_from_box
   Eigen::Vector3d half_extent = Eigen::Vector3d::Zero();  // half sizes along the box axes (units)
@@ -43,8 +43,8 @@ struct PredictedVolumeOptions {
   int64_t step_us = 250000;      // spacing of the predictions (µs)
   bool include_current = true;   // a volume at horizon 0 first
   double probability = 0.9;      // particle mass each box holds (0, 1]
-  double accel_margin = 0.5;     // unmodelled acceleration: half sizes grow by a t^2 / 2 (units/s^2)
-  int max_samples = 500;         // particles used (deterministic weighted subsample) (count)
+  double accel_margin = 0.5;  // unmodelled acceleration: half sizes grow by a t^2 / 2 (units/s^2)
+  int max_samples = 256;      // particles used (deterministic weighted subsample) (count)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(horizon_us, 0);
@@ -69,8 +69,8 @@ struct PredictedVolumeOptions {
 // of them, grown by the object's half sizes along the box axes and by `margin` (units).
 // `up`: the world's up direction if known (unit). Empty input gives a zero box.
 PredictedVolume BoundingVolume(const std::vector<Eigen::Vector3d>& centers,
-                               const std::optional<Eigen::Vector3d>& up,
-                               const ObjectExtent& extent, double probability, double margin);
+                               const std::optional<Eigen::Vector3d>& up, const ObjectExtent& extent,
+                               double probability, double margin);
 
 }  // namespace mbslam
 

@@ -21,19 +21,17 @@ Rigid3d ScaledCamFromObject(const Rigid3d& cam_from_obj, double scale) {
   return Rigid3d(cam_from_obj.rotation, scale * cam_from_obj.translation);
 }
 
-Rigid3d WorldFromObject(const Rigid3d& cam_from_world, const Rigid3d& cam_from_obj,
-                        double scale) {
+Rigid3d WorldFromObject(const Rigid3d& cam_from_world, const Rigid3d& cam_from_obj, double scale) {
   return cam_from_world.Inverse() * ScaledCamFromObject(cam_from_obj, scale);
 }
 
-Sim3d WorldFromObjectMap(const Rigid3d& cam_from_world, const Rigid3d& cam_from_obj,
-                         double scale) {
+Sim3d WorldFromObjectMap(const Rigid3d& cam_from_world, const Rigid3d& cam_from_obj, double scale) {
   const Rigid3d world_from_cam = cam_from_world.Inverse();
   Sim3d sim;
   sim.scale = scale;
   sim.rotation = (world_from_cam.rotation * cam_from_obj.rotation).normalized();
-  sim.translation = world_from_cam.rotation * (scale * cam_from_obj.translation) +
-                    world_from_cam.translation;
+  sim.translation =
+      world_from_cam.rotation * (scale * cam_from_obj.translation) + world_from_cam.translation;
   return sim;
 }
 

@@ -48,8 +48,7 @@ Rigid3d WorldFromObject(const Rigid3d& cam_from_world, const Rigid3d& cam_from_o
 
 // The similarity that maps object map points (object map units) into the world:
 // x_world = world_from_cam * (s * (cam_from_obj * x_obj)).
-Sim3d WorldFromObjectMap(const Rigid3d& cam_from_world, const Rigid3d& cam_from_obj,
-                         double scale);
+Sim3d WorldFromObjectMap(const Rigid3d& cam_from_world, const Rigid3d& cam_from_obj, double scale);
 
 // The object's map points in the world at the time of (cam_from_world, cam_from_obj).
 std::vector<Eigen::Vector3d> ObjectPointsInWorld(const std::vector<Eigen::Vector3d>& points_in_obj,
