@@ -31,10 +31,25 @@ echo "== perception_service (lockstep replay of $input)"
   --output-dir "$out/result" --output-log "$out/perception_output.lcmlog" \
   --set service.log_level=warning 2>"$out/perception.log"
 
+snapshots=""
+if [[ -x "$bin/viewer" && -x "$bin/merge_lcm_logs" ]]; then
+  echo "== viewer (offscreen snapshots of the outputs over the camera images)"
+  "$bin/merge_lcm_logs" "$out/merged.lcmlog" "$input" "$out/perception_output.lcmlog" >/dev/null
+  "$bin/viewer" --config config/viewer.yaml --lcm-url "file://$out/merged.lcmlog?speed=0" \
+    --out "$out/snapshots" --set viewer.log_level=warning --set viewer.snapshot_period_s=2.0 \
+    2>"$out/viewer.log"
+  snapshots="$out/snapshots"
+fi
+
 echo "== outputs"
 echo "camera trajectory : $out/result/camera_trajectory.tum"
+echo "object tracks     : $out/result/objects/"
+echo "static map        : $out/result/map.ply"
 echo "run summary       : $out/result/summary.json"
 echo "output log        : $out/perception_output.lcmlog (PERCEPTION_* channels, replay with lcm-logplayer)"
 echo "service log       : $out/perception.log"
+if [[ -n "$snapshots" ]]; then
+  echo "snapshots         : $snapshots/view3d_latest.png, $snapshots/image_latest.png"
+fi
 cat "$out/result/summary.json"
 echo "demo finished in $(( $(date +%s) - start )) s"

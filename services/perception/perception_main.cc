@@ -9,6 +9,8 @@
 //   perception_service --lcm-url 'file://seq.lcmlog?speed=0' --mode lockstep --output-log out.lcmlog
 
 #include <cstdio>
+
+#include <opencv2/core/utility.hpp>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -62,6 +64,9 @@ std::string OverrideToYaml(const std::string& assignment, bool* ok) {
 
 int Run(int argc, char** argv) {
   InstallShutdownHandlers();
+  // The pipeline has its own threads; OpenCV's worker pool on top of them would only
+  // oversubscribe the cores and make timings (and floating-point reductions) vary.
+  cv::setNumThreads(1);
   std::string config_path;
   std::vector<std::string> overrides;
   bool print_config = false;
