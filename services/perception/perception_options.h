@@ -50,6 +50,8 @@ struct PerceptionOptions {
   OdometryOptions odometry;
   SlamOptions slam;
   GroundPlaneOptions ground;
+  OccupancyMapOptions occupancy;
+  bool occupancy_enabled = true;
 
   CoreOptions core() const {
     CoreOptions c;
@@ -60,6 +62,8 @@ struct PerceptionOptions {
     c.odometry = odometry;
     c.slam = slam;
     c.ground = ground;
+    c.occupancy = occupancy;
+    c.occupancy_enabled = occupancy_enabled;
     // Lockstep replays must be deterministic: bundle adjustment runs inline there.
     if (pipeline.lockstep()) c.slam.background_ba = false;
     return c;
@@ -77,6 +81,7 @@ struct PerceptionOptions {
     MBSLAM_CHECK_OPTION_SECTION(odometry);
     MBSLAM_CHECK_OPTION_SECTION(slam);
     MBSLAM_CHECK_OPTION_SECTION(ground);
+    MBSLAM_CHECK_OPTION_SECTION(occupancy);
     return true;
   }
   template <typename V>
@@ -92,6 +97,8 @@ struct PerceptionOptions {
     v("odometry", &odometry, "ego-motion from wheel odometry (thesis sec. 3.8)");
     v("slam", &slam, "static-world keyframe SLAM (thesis ch. 4)");
     v("ground", &ground, "ground plane from the static map (sec. 5.1.1)");
+    v("occupancy_enabled", &occupancy_enabled, "build and publish the static-world occupancy map");
+    v("occupancy", &occupancy, "OctoMap occupancy of the static world (sec. 6.3)");
   }
 };
 

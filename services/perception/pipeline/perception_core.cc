@@ -17,6 +17,7 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
       segmentation_timer_(timers->Get("segmentation")),
       slam_timer_(timers->Get("slam_tracking")),
       mapping_timer_(timers->Get("slam_mapping")),
+      occupancy_timer_(timers->Get("occupancy")),
       odometry_(options.preprocess.max_odometry_gap_us,
                 static_cast<size_t>(options.preprocess.max_odometry_samples)),
       tracker_(options.tracking),
@@ -31,6 +32,7 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
 void PerceptionCore::Reset() {
   slam_.Reset();
   ground_.reset();
+  occupancy_.reset();
   tracker_.Reset();
   segmenter_.Reset();
   odometry_.Clear();
@@ -159,6 +161,38 @@ DepthBound PerceptionCore::DepthBoundFor(int64_t track_id, const Eigen::Vector2d
   bound.z_max = std::min(bound.z_max, cap);
   if (bound.z_min > bound.z_max) bound.z_min = 0.0;  // the map point itself is below ground: not trusted
   return bound;
+}
+
+void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime, FrameResult* result) {
+  if (!options_.occupancy_enabled) return;
+  ScopedStageTimer timer(occupancy_timer_);
+  const OccupancyMap::Units units = slam_.metric() ? OccupancyMap::Units::kMetres : OccupancyMap::Units::kUpToScale;
+  if (update.rescaled_by && occupancy_) {
+    const Status s = occupancy_->Rescale(*update.rescaled_by, units);
+    if (!s.ok()) {
+      MBSLAM_LOG(WARNING) << "occupancy rescale: " << s.message() << "; starting a new occupancy map";
+      occupancy_.reset();
+    }
+  }
+  if (!update.new_keyframe || update.new_point_ids.empty()) return;
+  if (!occupancy_) occupancy_ = std::make_unique<OccupancyMap>(options_.occupancy, units);
+  const Keyframe* kf = slam_.map().LastKeyframe();
+  if (kf == nullptr) return;
+  // Rays from the keyframe's camera centre to the points triangulated there (sec. 6.3);
+  // only static points ever enter the map.
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(update.new_point_ids.size());
+  for (int64_t id : update.new_point_ids) {
+    if (const MapPoint* p = slam_.map().point(id)) points.push_back(p->position);
+  }
+  occupancy_->InsertRays(kf->cam_from_world.Inverse().translation, points);
+  if (!occupancy_->IsResolutionFixed()) return;
+  OccupancyOutput out;
+  out.utime = utime;
+  out.scale_state = slam_.metric() ? ScaleState::kMetric : ScaleState::kUpToScale;
+  out.resolution = occupancy_->resolution();
+  out.num_occupied = static_cast<int>(occupancy_->NumOccupied());
+  if (occupancy_->Serialize(&out.octree_binary).ok()) result->occupancy = std::move(out);
 }
 
 MapOutput PerceptionCore::BuildMapOutput(int64_t utime) const {
@@ -336,6 +370,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     }
   }
   if (map_update.new_keyframe) UpdateGroundPlane();
+  UpdateOccupancy(map_update, frame.utime, &result);
   if (map_update.rescaled_by && ground_) ground_->Rescale(*map_update.rescaled_by);
   FillCameraPose(slam_pose, &result.camera_pose);
   result.world_rescaled_by = map_update.rescaled_by;

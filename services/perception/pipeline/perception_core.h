@@ -16,6 +16,7 @@
 #include "common/config/options.h"
 #include "services/perception/geometry/pose_buffer.h"
 #include "services/perception/objects/ground_plane.h"
+#include "services/perception/occupancy/occupancy_map.h"
 #include "services/perception/pipeline/counters.h"
 #include "services/perception/pipeline/frame_processor.h"
 #include "services/perception/pipeline/stage_timers.h"
@@ -98,6 +99,8 @@ struct CoreOptions {
   OdometryOptions odometry;
   SlamOptions slam;
   GroundPlaneOptions ground;
+  OccupancyMapOptions occupancy;
+  bool occupancy_enabled = true;      // build and publish the static-world occupancy map
   int map_publish_every_frames = 15;  // PERCEPTION_MAP at most this often, and at every keyframe
   double ground_depth_margin = 0.15;  // depth bound from the ground: static points lie above it (fraction)
   double ground_min_elevation_deg = 3.0;  // rays closer to the horizon get no ground bound (deg)
@@ -121,6 +124,8 @@ class PerceptionCore : public FrameProcessor {
   std::optional<Rigid3d> OdometryCameraPose(int64_t utime) const;
   void FillCameraPose(const SlamPose& pose, CameraPoseOutput* out) const;
   void UpdateGroundPlane();
+  // Rays from the new keyframe to its new static points; the tree re-published when it changed.
+  void UpdateOccupancy(const SlamMapUpdate& update, int64_t utime, FrameResult* result);
   // SLAM's depth bound of a track, capped by where its ray meets the ground.
   DepthBound DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const;
   MapOutput BuildMapOutput(int64_t utime) const;
@@ -133,6 +138,7 @@ class PerceptionCore : public FrameProcessor {
   TimingStats* segmentation_timer_;
   TimingStats* slam_timer_;
   TimingStats* mapping_timer_;
+  TimingStats* occupancy_timer_;
   PoseBuffer odometry_;
   Rigid3d base_from_cam_;
   FeatureTracker tracker_;
@@ -140,6 +146,7 @@ class PerceptionCore : public FrameProcessor {
   PersonDetector person_detector_;
   SlamSystem slam_;
   std::optional<GroundPlane> ground_;
+  std::unique_ptr<OccupancyMap> occupancy_;  // static world only (sec. 6.3); null until rays arrive
   int64_t last_map_publish_frame_ = -1000000;
   std::vector<cv::Mat> pyramid_;
   std::map<int64_t, int64_t> frame_utime_;   // frame index -> image time (recent frames)
