@@ -7,8 +7,12 @@ eval_scenario() {
   local name="$1" frames="${2:-300}"
   local seq
   seq=$(sim_sequence "$name" "$frames")
-  run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/run"
-  local ate seg ate_nf="{}" occ="{}"
+  # The camera's mounting height above the ground (the simulated world's ground is z = 0):
+  # what a robot's configuration holds; it gives the object filters metres per map unit.
+  local cam_height
+  cam_height=$(awk '!/^#/ && NF >= 8 {s += $4; n++} END {if (n) printf "%.3f", s / n; else print 0}' "$seq/cam_trajectory.tum")
+  run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/run" --set "objects.camera_height_m=$cam_height" ${SERVICE_ARGS:-}
+  local ate seg ate_nf="{}" occ="{}" obj="{}" obj05="{}"
   ate=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/run/result/camera_trajectory.tum" \
         --gt-sequence "$seq" --plot "$MBSLAM_EVAL_OUT/trajectory.png")
   seg=$(last_json "$MBSLAM_BIN/mbslam-eval-segmentation" --run "$MBSLAM_EVAL_OUT/run/out.lcmlog" --sequence "$seq" --name "$name")
@@ -16,20 +20,31 @@ eval_scenario() {
     occ=$(last_json "$MBSLAM_BIN/mbslam-eval-occupancy" --bt "$MBSLAM_EVAL_OUT/run/result/occupancy.bt" \
           --sequence "$seq" --est-traj "$MBSLAM_EVAL_OUT/run/result/camera_trajectory.tum" --pixel-step 4 --frame-step 5)
   fi
+  if [[ "${OBJECTS:-1}" == "1" ]]; then
+    obj=$(last_json "$MBSLAM_BIN/mbslam-eval" objects --est-log "$MBSLAM_EVAL_OUT/run/out.lcmlog" \
+          --gt-log "$seq/sequence.lcmlog" --horizon-us 1000000 || echo "{}")
+    obj05=$(last_json "$MBSLAM_BIN/mbslam-eval" objects --est-log "$MBSLAM_EVAL_OUT/run/out.lcmlog" \
+          --gt-log "$seq/sequence.lcmlog" --horizon-us 500000 || echo "{}")
+  fi
   if [[ "${ABLATION:-0}" == "1" ]]; then
-    run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/no_feedback" --set slam.use_segmentation=false
+    run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/no_feedback" --set slam.use_segmentation=false \
+      --set "objects.camera_height_m=$cam_height"
     ate_nf=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/no_feedback/result/camera_trajectory.tum" \
              --gt-sequence "$seq")
   fi
   local len
   len=$(path_length "$seq/cam_trajectory.tum")
-  python3 - "$name" "$ate" "$seg" "$ate_nf" "$len" "$MBSLAM_EVAL_OUT/run/result/summary.json" "$occ" <<'PY'
+  python3 - "$name" "$ate" "$seg" "$ate_nf" "$len" "$MBSLAM_EVAL_OUT/run/result/summary.json" "$occ" "$obj" "$obj05" "$cam_height" <<'PY'
 import json, sys
 name, ate, seg, ate_nf, length = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3]), json.loads(sys.argv[4]), float(sys.argv[5])
 summary = json.load(open(sys.argv[6]))
 occ = json.loads(sys.argv[7])
+obj = json.loads(sys.argv[8] or "{}")
+obj05 = json.loads(sys.argv[9] or "{}")
+objs = obj.get("objects", [])
+scales = [o["relative_scale_error"] for o in objs if o.get("settled_samples", 0) > 0]
 rmse = ate.get("ate_rmse_m")
-out = {"scenario": name, "path_length_m": length,
+out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float(sys.argv[10]),
        "ate_rmse_m": rmse, "ate_rel_path": rmse / length if (rmse is not None and length > 0) else None,
        "tracked_fraction": ate.get("fraction_tracked"), "sim3_scale": ate.get("scale"),
        "moving_recall": seg.get("moving_recall"), "moving_precision": seg.get("moving_precision"),
@@ -38,6 +53,14 @@ out = {"scenario": name, "path_length_m": length,
        "detection_delay_frames": seg.get("detection_delay_frames"),
        "occupancy_precision": occ.get("occupancy_precision"), "occupancy_recall": occ.get("occupancy_recall"),
        "occupancy_voxel_m": occ.get("resolution_m"),
+       "objects_estimated": obj.get("est_objects"), "objects_true": obj.get("gt_bodies"),
+       "objects_matched": obj.get("matched"),
+       "object_pos_err_rel_2s": obj.get("pos_err_rel_settled"),
+       "relative_scale_error": (sum(scales) / len(scales)) if scales else None,
+       "predicted_hit_rate_1s": obj.get("volume_hit_rate") if obj.get("volumes_checked") else None,
+       "predicted_hit_rate_0_5s": obj05.get("volume_hit_rate") if obj05.get("volumes_checked") else None,
+       "objects": [{k: o.get(k) for k in ("est_id", "name", "samples", "settled_samples", "pos_err_rel_settled_mean",
+                                          "pos_err_rel_at_settle", "relative_scale_error", "volume_hit_rate")} for o in objs],
        "timings_ms": {k: v.get("mean_ms") for k, v in summary.get("timings", {}).items()}}
 if ate_nf:
     out["ate_rel_path_no_feedback"] = ate_nf["ate_rmse_m"] / length if ("ate_rmse_m" in ate_nf and length > 0) else None
@@ -46,6 +69,10 @@ def pct(v):
     return "n/a" if v is None else f"{100*v:.3f} %"
 print(f"sim-{name}: ATE {pct(out['ate_rel_path'])} of {length:.2f} m, tracked {pct(out['tracked_fraction'])}, "
       f"moving recall {out['moving_recall']}, precision {out['moving_precision']}, false moving {out['false_moving_fraction']}")
+if obj:
+    print(f"  objects: {obj.get('est_objects')} estimated, {obj.get('matched')} matched of {obj.get('gt_bodies')}; "
+          f"error/range from 2 s {out['object_pos_err_rel_2s']}, relative scale error {out['relative_scale_error']}, "
+          f"volumes hit +0.5 s {out['predicted_hit_rate_0_5s']} +1 s {out['predicted_hit_rate_1s']}")
 if occ:
     print(f"  occupancy: precision {occ.get('occupancy_precision')}, recall {occ.get('occupancy_recall')} (voxel {occ.get('resolution_m')} m)")
 if ate_nf:

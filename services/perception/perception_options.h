@@ -52,6 +52,7 @@ struct PerceptionOptions {
   GroundPlaneOptions ground;
   OccupancyMapOptions occupancy;
   bool occupancy_enabled = true;
+  ObjectTrackingOptions objects;
 
   CoreOptions core() const {
     CoreOptions c;
@@ -64,6 +65,7 @@ struct PerceptionOptions {
     c.ground = ground;
     c.occupancy = occupancy;
     c.occupancy_enabled = occupancy_enabled;
+    c.objects = objects;
     // Lockstep replays must be deterministic: bundle adjustment runs inline there.
     if (pipeline.lockstep()) c.slam.background_ba = false;
     return c;
@@ -82,6 +84,7 @@ struct PerceptionOptions {
     MBSLAM_CHECK_OPTION_SECTION(slam);
     MBSLAM_CHECK_OPTION_SECTION(ground);
     MBSLAM_CHECK_OPTION_SECTION(occupancy);
+    MBSLAM_CHECK_OPTION_SECTION(objects);
     return true;
   }
   template <typename V>
@@ -99,6 +102,7 @@ struct PerceptionOptions {
     v("ground", &ground, "ground plane from the static map (sec. 5.1.1)");
     v("occupancy_enabled", &occupancy_enabled, "build and publish the static-world occupancy map");
     v("occupancy", &occupancy, "OctoMap occupancy of the static world (sec. 6.3)");
+    v("objects", &objects, "bearing-only tracking of moving objects, extent, predicted volumes (ch. 5-6)");
   }
 };
 

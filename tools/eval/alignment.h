@@ -20,6 +20,14 @@ Status UmeyamaAlignment(const std::vector<Eigen::Vector3d>& src,
                         const std::vector<Eigen::Vector3d>& dst, bool with_scale,
                         Sim3d* dst_from_src);
 
+// For a path along one line (a car driving straight), where the positions leave the
+// rotation about the line undetermined: the rotation from the camera orientations (the
+// chordal mean of R_dst_i R_src_i^T, projected onto SO(3)), then the scale and
+// translation by least squares on the positions. Needs >= 2 poses whose positions do
+// not all coincide when with_scale.
+Status OrientationAlignment(const std::vector<Rigid3d>& src, const std::vector<Rigid3d>& dst,
+                            bool with_scale, Sim3d* dst_from_src);
+
 }  // namespace eval
 }  // namespace mbslam
 

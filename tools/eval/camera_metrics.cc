@@ -81,9 +81,19 @@ Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions&
     dst.push_back(gt[p.gt].pose.translation);
   }
   if (alignment != Alignment::kNone) {
-    MBSLAM_RETURN_IF_ERROR(
-        UmeyamaAlignment(src, dst, alignment == Alignment::kSim3, &result->gt_from_est)
-            .WithContext("ATE"));
+    const bool with_scale = alignment == Alignment::kSim3;
+    const Status st = UmeyamaAlignment(src, dst, with_scale, &result->gt_from_est);
+    if (!st.ok()) {
+      // A straight path leaves the rotation about it to the camera orientations.
+      std::vector<Rigid3d> src_poses, dst_poses;
+      for (const auto& p : result->pairs) {
+        src_poses.push_back(est[p.est].pose);
+        dst_poses.push_back(gt[p.gt].pose);
+      }
+      MBSLAM_RETURN_IF_ERROR(
+          OrientationAlignment(src_poses, dst_poses, with_scale, &result->gt_from_est).WithContext("ATE"));
+      result->orientation_aligned = true;
+    }
   }
   std::vector<double> rot;
   for (const auto& p : result->pairs) {

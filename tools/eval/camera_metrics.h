@@ -58,6 +58,7 @@ struct AteResult {
   ErrorStats rotation_deg;     // angle of R_gt^T R_aligned_est (deg)
   std::vector<double> errors;  // translation error per pair (m)
   Trajectory est_aligned;      // aligned estimate poses, one per pair
+  bool orientation_aligned = false;  // collinear path: rotation from the camera orientations
 };
 
 // Associates by time, aligns (Umeyama on the camera centres) and measures.

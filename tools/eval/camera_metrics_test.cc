@@ -37,6 +37,38 @@ Sim3d KnownSimilarity() {
   return s;
 }
 
+TEST(OrientationAlignment, RecoversSimilarityOfAStraightPath) {
+  // A camera driving straight and turning its head: positions on one line.
+  const Sim3d S = KnownSimilarity();
+  std::vector<Rigid3d> src, dst;
+  for (int i = 0; i < 30; ++i) {
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(0.02 * i, Eigen::Vector3d(0.3, 1.0, 0.1).normalized()));
+    src.emplace_back(q, Eigen::Vector3d(0.5 * i, 0.0, 0.0));
+    dst.push_back(S * src.back());
+  }
+  std::vector<Eigen::Vector3d> ps, pd;
+  for (size_t i = 0; i < src.size(); ++i) {
+    ps.push_back(src[i].translation);
+    pd.push_back(dst[i].translation);
+  }
+  Sim3d est;
+  EXPECT_FALSE(UmeyamaAlignment(ps, pd, true, &est).ok());  // rotation about the line unknown
+  ASSERT_TRUE(OrientationAlignment(src, dst, true, &est).ok());
+  EXPECT_NEAR(est.scale, S.scale, 1e-10);
+  EXPECT_LT(est.rotation.angularDistance(S.rotation), 1e-10);
+  EXPECT_LT((est.translation - S.translation).norm(), 1e-9);
+  // The ATE of the exact copy is zero with this fallback.
+  Trajectory e, g;
+  for (size_t i = 0; i < src.size(); ++i) {
+    e.push_back({static_cast<int64_t>(i) * 100000, src[i]});
+    g.push_back({static_cast<int64_t>(i) * 100000, dst[i]});
+  }
+  AteResult ate;
+  ASSERT_TRUE(ComputeAte(e, g, AteOptions(), &ate).ok());
+  EXPECT_TRUE(ate.orientation_aligned);
+  EXPECT_LT(ate.translation.rmse, 1e-9);
+}
+
 TEST(Umeyama, RecoversSimilarityExactly) {
   std::mt19937 rng(4);
   std::normal_distribution<double> n(0.0, 3.0);

@@ -244,7 +244,7 @@ int RunAte(const Args& args) {
     std::printf("  plot: %s\n", args.Get("plot").c_str());
   }
   Json j = Json::Object();
-  j.Set("metric", "ate").Set("alignment", options.alignment);
+  j.Set("metric", "ate").Set("alignment", options.alignment).Set("orientation_aligned", ate.orientation_aligned);
   j.Set("ate_rmse_m", ate.translation.rmse).Set("ate_mean_m", ate.translation.mean);
   j.Set("ate_median_m", ate.translation.median).Set("ate_max_m", ate.translation.max);
   j.Set("ate_rot_rmse_deg", ate.rotation_deg.rmse).Set("scale", ate.gt_from_est.scale);
@@ -549,6 +549,7 @@ int RunObjects(const Args& args) {
   eval::ObjectMetricsOptions options;
   options.horizon_us = args.GetInt("horizon-us", options.horizon_us);
   options.max_match_distance = args.GetDouble("max-match-m", options.max_match_distance);
+  options.settle_us = args.GetInt("settle-us", options.settle_us);
   eval::ObjectsEvaluation result;
   st = eval::EvaluateObjects(objects, gt.bodies, gt.camera, ate.gt_from_est, options, &result);
   if (!st.ok()) {
@@ -577,6 +578,10 @@ int RunObjects(const Args& args) {
         .Set("position_scaled_rmse_m", o.position_error_scaled.rmse);
     oj.Set("best_scale", o.best_scale).Set("relative_scale_error", o.relative_scale_error);
     oj.Set("depth_rmse_m", o.depth_error.rmse).Set("volume_hit_rate", o.hit_rate);
+    oj.Set("settled_samples", o.settled_samples)
+        .Set("pos_err_rel_settled_mean", o.rel_error_settled_mean)
+        .Set("pos_err_rel_settled_median", o.rel_error_settled_median)
+        .Set("pos_err_rel_at_settle", o.rel_error_at_settle);
     Json series = Json::Array();
     for (const auto& d : o.depth_error_over_time) {
       series.Push(d.second);
@@ -593,6 +598,8 @@ int RunObjects(const Args& args) {
       .Set("gt_bodies", result.num_gt_bodies);
   j.Set("matched", result.objects.size()).Set("unmatched_est", result.unmatched_est);
   j.Set("volume_hit_rate", result.hit_rate).Set("volumes_checked", result.volumes_checked);
+  j.Set("settle_us", options.settle_us).Set("settled_samples", result.settled_samples);
+  if (result.rel_error_settled_mean >= 0.0) j.Set("pos_err_rel_settled", result.rel_error_settled_mean);
   j.Set("camera_ate_rmse_m", ate.translation.rmse).Set("objects", list);
   return Finish(j, args);
 }
@@ -802,7 +809,7 @@ void Usage() {
   camvid   where features labelled moving fall in CamVid's classes (false detections on static classes)
            --features FILE ("stem u v moving" per line) [--root DIR]
   objects  per-object trajectory / scale / depth errors and predicted-volume hit rate
-           --est-log LOG --gt-log LOG [--horizon-us N] [--align sim3|se3] [--max-match-m M]
+           --est-log LOG --gt-log LOG [--horizon-us N] [--align sim3|se3] [--max-match-m M] [--settle-us N]
   points   reconstruction accuracy / completeness against ground-truth surface points
            --est XYZ --gt XYZ (e.g. <sequence>/points/<id>.txt) [--threshold 0.05] [--max-distance 1.0]
   perturb  write a trajectory with a known similarity and noise (expected ATE printed)

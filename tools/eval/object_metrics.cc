@@ -135,6 +135,7 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     }
   }
   const std::vector<int> assignment = SolveAssignment(cost);
+  std::vector<double> all_rel;
   for (size_t i = 0; i < est_list.size(); ++i) {
     const int j = assignment[i];
     if (j < 0 || cost(static_cast<Eigen::Index>(i), j) >= kForbidden) {
@@ -166,6 +167,28 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
       depth.push_back(std::abs(est_depth - true_depth));
       r.depth_error_over_time.emplace_back(c.utime, est_depth - true_depth);
     }
+    if (!common.empty()) {
+      const int64_t t0 = common.front().utime;
+      std::vector<double> rel;
+      for (const auto& c : common) {
+        if (c.utime - t0 < options.settle_us) continue;
+        const double range = (c.truth - c.camera).norm();
+        if (!(range > 0.0)) continue;
+        const double e = (c.est - c.truth).norm() / range;
+        if (rel.empty()) r.rel_error_at_settle = e;
+        rel.push_back(e);
+        all_rel.push_back(e);
+      }
+      r.settled_samples = static_cast<int>(rel.size());
+      if (!rel.empty()) {
+        double sum = 0.0;
+        for (double e : rel) sum += e;
+        r.rel_error_settled_mean = sum / static_cast<double>(rel.size());
+        std::vector<double> sorted = rel;
+        std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+        r.rel_error_settled_median = sorted[sorted.size() / 2];
+      }
+    }
     r.position_error = ErrorStats::From(plain);
     r.position_error_scaled = ErrorStats::From(scaled);
     r.depth_error = ErrorStats::From(depth);
@@ -191,6 +214,12 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     result->volumes_checked += r.volumes_checked;
     result->volumes_hit += r.volumes_hit;
     result->objects.push_back(r);
+  }
+  result->settled_samples = static_cast<int>(all_rel.size());
+  if (!all_rel.empty()) {
+    double sum = 0.0;
+    for (double e : all_rel) sum += e;
+    result->rel_error_settled_mean = sum / static_cast<double>(all_rel.size());
   }
   result->hit_rate = result->volumes_checked > 0
                          ? static_cast<double>(result->volumes_hit) / result->volumes_checked

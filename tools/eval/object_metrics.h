@@ -65,6 +65,7 @@ struct ObjectMetricsOptions {
   int min_samples = 3;  // fewest common samples for a match (count)
   int64_t horizon_us = 1000000;          // predicted-volume horizon evaluated (µs)
   int64_t horizon_tolerance_us = 50000;  // volumes within this of the horizon count (µs)
+  int64_t settle_us = 2000000;  // relative errors are scored from this long after the first sample (µs)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(max_time_diff_us, 0);
@@ -72,6 +73,7 @@ struct ObjectMetricsOptions {
     MBSLAM_CHECK_OPTION_GE(min_samples, 1);
     MBSLAM_CHECK_OPTION_GE(horizon_us, 0);
     MBSLAM_CHECK_OPTION_GE(horizon_tolerance_us, 0);
+    MBSLAM_CHECK_OPTION_GE(settle_us, 0);
     return true;
   }
   template <typename V>
@@ -83,6 +85,7 @@ struct ObjectMetricsOptions {
     v("horizon_us", &horizon_us, "predicted-volume horizon evaluated (µs)");
     v("horizon_tolerance_us", &horizon_tolerance_us,
       "volumes within this of the horizon count (µs)");
+    v("settle_us", &settle_us, "relative errors scored from this long after the first sample (µs)");
   }
 };
 
@@ -97,6 +100,12 @@ struct ObjectResult {
   double relative_scale_error = 0.0;  // |best_scale - 1|
   ErrorStats depth_error;             // |depth - true depth| (m)
   std::vector<std::pair<int64_t, double>> depth_error_over_time;  // (utime, signed error m)
+  // Position error / range (true camera-to-object distance), each sample from settle_us
+  // after the object's first sample on: the filter has had that long to converge.
+  int settled_samples = 0;
+  double rel_error_settled_mean = 0.0;
+  double rel_error_settled_median = 0.0;
+  double rel_error_at_settle = -1.0;  // the first sample at or after settle_us (< 0: none)
   int volumes_checked = 0;
   int volumes_hit = 0;  // true centre inside the predicted box
   double hit_rate = 0.0;
@@ -110,6 +119,9 @@ struct ObjectsEvaluation {
   int volumes_checked = 0;
   int volumes_hit = 0;
   double hit_rate = 0.0;  // over all matched objects
+  // Over every settled sample of every matched object (see ObjectResult); < 0 if none.
+  int settled_samples = 0;
+  double rel_error_settled_mean = -1.0;
 };
 
 // World pose of a body at `utime` by interpolation (false if outside its samples or the

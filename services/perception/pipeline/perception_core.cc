@@ -18,12 +18,14 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
       slam_timer_(timers->Get("slam_tracking")),
       mapping_timer_(timers->Get("slam_mapping")),
       occupancy_timer_(timers->Get("occupancy")),
+      objects_timer_(timers->Get("objects")),
       odometry_(options.preprocess.max_odometry_gap_us,
                 static_cast<size_t>(options.preprocess.max_odometry_samples)),
       tracker_(options.tracking),
       segmenter_(options.segmentation),
       person_detector_(options.person),
-      slam_(options.slam) {
+      slam_(options.slam),
+      object_tracking_(options.objects) {
   const auto& q = options.odometry.base_from_cam_rotation;
   const auto& t = options.odometry.base_from_cam_translation;
   base_from_cam_ = Rigid3d(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), Eigen::Vector3d(t[0], t[1], t[2]));
@@ -33,6 +35,7 @@ void PerceptionCore::Reset() {
   slam_.Reset();
   ground_.reset();
   occupancy_.reset();
+  object_tracking_.Reset();
   tracker_.Reset();
   segmenter_.Reset();
   odometry_.Clear();
@@ -193,6 +196,39 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
   out.resolution = occupancy_->resolution();
   out.num_occupied = static_cast<int>(occupancy_->NumOccupied());
   if (occupancy_->Serialize(&out.octree_binary).ok()) result->occupancy = std::move(out);
+}
+
+void PerceptionCore::FillObjectEstimate(const TrackedObject& t, ObjectOutput* out) const {
+  const BotEstimate& e = t.estimate;
+  out->state = e.reliable ? ObjectState::kTracked : ObjectState::kDetected;
+  // The published pose is the object's box centre (the filter follows a reference point
+  // on its visible surface; the extent gives the offset).
+  out->world_from_object = e.world_from_object;
+  out->world_from_object.translation = t.center;
+  out->pose_covariance = e.pose_covariance;
+  out->linear_velocity = e.linear_velocity;
+  out->angular_velocity = e.angular_velocity;
+  out->velocity_covariance = e.velocity_covariance;
+  out->depth = e.depth;
+  out->depth_sigma = e.depth_sigma;
+  out->num_particles = e.num_particles;
+  out->effective_sample_size = e.effective_sample_size;
+  out->particle_samples = e.particle_samples;
+  if (t.extent.valid) out->extent = t.extent.SizeAlong(e.world_from_object.rotation);
+  if (e.relative_scale) {
+    out->relative_scale = e.relative_scale->scale;
+    out->relative_scale_sigma = e.relative_scale->sigma;
+  }
+  for (const PredictedVolume& v : t.volumes) {
+    PredictedVolumeOutput pv;
+    pv.utime = v.utime;
+    pv.horizon_us = v.horizon_us;
+    pv.center = v.center;
+    pv.orientation = v.orientation;
+    pv.half_extent = v.half_extent;
+    pv.probability = v.probability;
+    out->volumes.push_back(pv);
+  }
 }
 
 MapOutput PerceptionCore::BuildMapOutput(int64_t utime) const {
@@ -357,6 +393,18 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     label_of[l.id] = &l;
     body_of[l.id] = l.body_id;
   }
+  // Objects whose tracks are still static map points: previously static objects start
+  // from their mapped depth (sec. 5.1.2). Read before the map releases those points.
+  std::map<int, std::vector<Eigen::Vector3d>> mapped_points_of;
+  if (options_.objects.enabled) {
+    for (const SegmentedObject& o : seg.objects) {
+      for (int64_t id : o.track_ids) {
+        const int64_t pid = slam_.map().PointOfTrack(id);
+        if (pid < 0) continue;
+        if (const MapPoint* p = slam_.map().point(pid)) mapped_points_of[o.id].push_back(p->position);
+      }
+    }
+  }
   // SLAM, step 2: the labels update the map (moving tracks leave it), keyframes, BA.
   SlamMapUpdate map_update;
   {
@@ -392,17 +440,87 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     t.p_static = static_cast<float>(it->second->p_static);
   }
 
+  // Bearing-only tracking of every moving object (ch. 5-6).
+  std::map<int, const TrackedObject*> tracked_of;
+  const std::vector<TrackedObject>* tracked = nullptr;
+  if (options_.objects.enabled) {
+    ScopedStageTimer timer(objects_timer_);
+    ObjectFrame of;
+    of.utime = frame.utime;
+    of.pose_valid = slam_pose.valid && slam_pose.state == SlamState::kTracking;
+    of.cam_from_world = slam_pose.cam_from_world;
+    // This image's pose was computed before a rescale of the world in this image.
+    if (map_update.rescaled_by) of.cam_from_world.translation *= *map_update.rescaled_by;
+    of.focal_px = 0.5 * (intrinsics.fx + intrinsics.fy);
+    of.metric = slam_.metric();
+    of.ground = ground_;
+    of.rescaled_by = map_update.rescaled_by;
+    std::unordered_map<int64_t, Eigen::Vector2d> xy_of;
+    for (const SlamObservation& so : slam_frame.observations) xy_of[so.track_id] = so.xy;
+    for (const SegmentedObject& o : seg.objects) {
+      ObjectObservation ob;
+      ob.id = o.id;
+      for (int64_t id : o.track_ids) {
+        auto it = xy_of.find(id);
+        if (it == xy_of.end()) continue;
+        ob.track_ids.push_back(id);
+        ob.track_xy.push_back(it->second);
+      }
+      if (ob.track_xy.empty()) continue;
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      for (const Eigen::Vector2d& p : ob.track_xy) c += p;
+      c /= static_cast<double>(ob.track_xy.size());
+      // The static world behind the object bounds its depth (sec. 5.1.1).
+      const DepthBound b = DepthBoundFor(-1, c, frame_index_);
+      if (std::isfinite(b.z_max) && b.z_max > 0.0) {
+        const double f = map_update.rescaled_by ? *map_update.rescaled_by : 1.0;
+        ob.background_depth = DepthRange{0.0, b.z_max * f};
+      }
+      auto mp = mapped_points_of.find(o.id);
+      if (mp != mapped_points_of.end()) {
+        ob.mapped_points = mp->second;
+        if (map_update.rescaled_by) {
+          for (Eigen::Vector3d& p : ob.mapped_points) p *= *map_update.rescaled_by;
+        }
+      }
+      of.objects.push_back(std::move(ob));
+    }
+    tracked = &object_tracking_.Update(of);
+    for (const TrackedObject& t : *tracked) tracked_of[t.id] = &t;
+  }
+  // Segmentation ids -> persistent object ids (the filters keep an object's identity when
+  // the segmentation re-labels it).
+  std::map<int, int> object_id_of;
+  std::map<int, const TrackedObject*> tracked_of_segment;
+  if (tracked) {
+    for (const TrackedObject& t : *tracked) {
+      if (t.seen) tracked_of_segment[t.segment_id] = &t;
+    }
+  }
+  for (const SegmentedObject& o : seg.objects) {
+    auto t = tracked_of_segment.find(o.id);
+    object_id_of[o.id] = t != tracked_of_segment.end() ? t->second->id
+                         : options_.objects.enabled   ? object_tracking_.PersistentId(o.id)
+                                                      : o.id;
+  }
+
   // Moving objects: hulls, person check, occluders for the next image.
   occluders_.clear();
   for (const SegmentedObject& o : seg.objects) {
+    const int oid = object_id_of[o.id];
     ObjectOutput out;
-    out.id = o.id;
+    out.id = oid;
     out.state = ObjectState::kDetected;
-    auto [first, inserted] = object_first_utime_.try_emplace(o.id, frame.utime);
+    auto tr = tracked_of.find(oid);
+    if (tr != tracked_of.end() && tr->second->seen) {
+      FillObjectEstimate(*tr->second, &out);
+      tracked_of.erase(tr);
+    }
+    auto [first, inserted] = object_first_utime_.try_emplace(oid, frame.utime);
     out.first_seen_utime = first->second;
     out.num_tracks = static_cast<int>(o.track_ids.size());
     HullOutput hull;
-    hull.body_id = o.id;
+    hull.body_id = oid;
     TrackingHints::Hull occ;
     occ.body_id = o.id;
     float min_x = 1e9f, min_y = 1e9f, max_x = -1e9f, max_y = -1e9f;
@@ -415,18 +533,29 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       max_y = std::max(max_y, static_cast<float>(p.y()));
     }
     if (options_.person.enabled && hull.points.size() >= 3) {
-      auto last = person_checked_.find(o.id);
+      auto last = person_checked_.find(oid);
       if (last == person_checked_.end() || frame_index_ - last->second >= options_.person.every_n_frames) {
         const cv::Rect box(static_cast<int>(min_x), static_cast<int>(min_y),
                            static_cast<int>(max_x - min_x), static_cast<int>(max_y - min_y));
-        if (person_detector_.Detect(frame.gray, box)) is_person_[o.id] = true;
-        person_checked_[o.id] = frame_index_;
+        if (person_detector_.Detect(frame.gray, box)) is_person_[oid] = true;
+        person_checked_[oid] = frame_index_;
       }
     }
-    out.object_class = is_person_[o.id] ? ObjectClass::kPerson : ObjectClass::kUnknown;
+    out.object_class = is_person_[oid] ? ObjectClass::kPerson : ObjectClass::kUnknown;
     out.hull = hull;
     result.hulls.push_back(hull);
     if (occ.points.size() >= 3) occluders_.push_back(std::move(occ));
+    result.objects.push_back(std::move(out));
+  }
+  // Objects not segmented in this image (occluded, left the view) but recently seen: the
+  // filter's prediction, without a hull.
+  for (const auto& [id, t] : tracked_of) {
+    ObjectOutput out;
+    out.id = id;
+    auto first = object_first_utime_.find(id);
+    out.first_seen_utime = first != object_first_utime_.end() ? first->second : t->last_seen_utime;
+    out.object_class = is_person_[id] ? ObjectClass::kPerson : ObjectClass::kUnknown;
+    FillObjectEstimate(*t, &out);
     result.objects.push_back(std::move(out));
   }
   result.epipole = seg.epipole;
@@ -438,6 +567,11 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     o.prev_uv = t.is_new ? Eigen::Vector2f::Constant(NAN) : t.prev_uv;
     o.age = t.age;
     o.body_id = t.body_id;
+    if (o.body_id > 0) {
+      auto id = object_id_of.find(o.body_id);
+      o.body_id = id != object_id_of.end() ? id->second
+                  : options_.objects.enabled ? object_tracking_.PersistentId(o.body_id) : o.body_id;
+    }
     o.p_static = t.p_static;
     o.occluded = !t.active();
     o.has_3d = slam_.HasPoint(t.id);

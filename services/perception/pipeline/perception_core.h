@@ -16,6 +16,7 @@
 #include "common/config/options.h"
 #include "services/perception/geometry/pose_buffer.h"
 #include "services/perception/objects/ground_plane.h"
+#include "services/perception/objects/object_tracking.h"
 #include "services/perception/occupancy/occupancy_map.h"
 #include "services/perception/pipeline/counters.h"
 #include "services/perception/pipeline/frame_processor.h"
@@ -101,6 +102,7 @@ struct CoreOptions {
   GroundPlaneOptions ground;
   OccupancyMapOptions occupancy;
   bool occupancy_enabled = true;      // build and publish the static-world occupancy map
+  ObjectTrackingOptions objects;
   int map_publish_every_frames = 15;  // PERCEPTION_MAP at most this often, and at every keyframe
   double ground_depth_margin = 0.15;  // depth bound from the ground: static points lie above it (fraction)
   double ground_min_elevation_deg = 3.0;  // rays closer to the horizon get no ground bound (deg)
@@ -129,6 +131,7 @@ class PerceptionCore : public FrameProcessor {
   // SLAM's depth bound of a track, capped by where its ray meets the ground.
   DepthBound DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const;
   MapOutput BuildMapOutput(int64_t utime) const;
+  void FillObjectEstimate(const TrackedObject& tracked, ObjectOutput* out) const;
   void Reset();
 
   const CoreOptions options_;
@@ -139,6 +142,7 @@ class PerceptionCore : public FrameProcessor {
   TimingStats* slam_timer_;
   TimingStats* mapping_timer_;
   TimingStats* occupancy_timer_;
+  TimingStats* objects_timer_;
   PoseBuffer odometry_;
   Rigid3d base_from_cam_;
   FeatureTracker tracker_;
@@ -146,6 +150,7 @@ class PerceptionCore : public FrameProcessor {
   PersonDetector person_detector_;
   SlamSystem slam_;
   std::optional<GroundPlane> ground_;
+  ObjectTracking object_tracking_;
   std::unique_ptr<OccupancyMap> occupancy_;  // static world only (sec. 6.3); null until rays arrive
   int64_t last_map_publish_frame_ = -1000000;
   std::vector<cv::Mat> pyramid_;

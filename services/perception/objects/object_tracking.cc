@@ -1,0 +1,283 @@
+#include "services/perception/objects/object_tracking.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/util/logging.h"
+
+namespace mbslam {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  return v[mid];
+}
+
+Eigen::Vector2d Centroid(const std::vector<Eigen::Vector2d>& xy) {
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& p : xy) c += p;
+  return xy.empty() ? c : Eigen::Vector2d(c / static_cast<double>(xy.size()));
+}
+
+}  // namespace
+
+ObjectTracking::ObjectTracking(const ObjectTrackingOptions& options) : options_(options) {
+  if (!options_.Check()) {
+    MBSLAM_LOG(ERROR) << "ObjectTracking: invalid options, using the defaults";
+    options_ = ObjectTrackingOptions();
+  }
+}
+
+void ObjectTracking::Reset() {
+  objects_.clear();
+  object_of_segment_.clear();
+  out_.clear();
+}
+
+int ObjectTracking::PersistentId(int segment_id) {
+  auto it = object_of_segment_.find(segment_id);
+  if (it != object_of_segment_.end()) return it->second;
+  const int id = next_id_++;
+  object_of_segment_[segment_id] = id;
+  return id;
+}
+
+int ObjectTracking::Reidentify(const ObjectFrame& frame, const ObjectObservation& o,
+                               const std::map<int, bool>& taken) const {
+  // Shared tracks first: a split or a re-labelled cluster keeps most of its tracks.
+  int best = 0;
+  size_t best_shared = 0;
+  for (const auto& [id, s] : objects_) {
+    if (taken.count(id)) continue;
+    size_t shared = 0;
+    for (int64_t t : o.track_ids) shared += s.last_xy.count(t);
+    if (shared > best_shared) {
+      best_shared = shared;
+      best = id;
+    }
+  }
+  if (best != 0 && static_cast<double>(best_shared) >= options_.reid_track_share * o.track_ids.size()) return best;
+  // Else the nearest prediction of an object not seen in this image.
+  const Eigen::Vector2d c = Centroid(o.track_xy);
+  double best_d = options_.reid_radius_px / std::max(frame.focal_px, 1e-9);
+  best = 0;
+  for (const auto& [id, s] : objects_) {
+    if (taken.count(id) || !s.filter.initialized()) continue;
+    bool seen_now = false;
+    for (const auto& [seg, obj] : object_of_segment_) {
+      if (obj == id && seg != o.id) {
+        for (const ObjectObservation& other : frame.objects) seen_now |= other.id == seg;
+      }
+    }
+    if (seen_now) continue;
+    const Eigen::Vector3d p = frame.cam_from_world * s.filter.Estimate().world_from_object.translation;
+    if (p.z() <= 0.0) continue;
+    const double d = (p.head<2>() / p.z() - c).norm();
+    if (d < best_d) {
+      best_d = d;
+      best = id;
+    }
+  }
+  return best;
+}
+
+double ObjectTracking::MetresPerUnit(const ObjectFrame& frame) const {
+  if (frame.metric) return 1.0;
+  if (options_.camera_height_m > 0.0 && frame.ground && frame.pose_valid) {
+    const Eigen::Vector3d c = frame.cam_from_world.Inverse().translation;
+    const double h = frame.ground->Height(c);
+    if (std::isfinite(h) && h > 1e-6) return options_.camera_height_m / h;
+  }
+  return options_.unit_guess_m;
+}
+
+BearingOnlyTrackerOptions ObjectTracking::FilterOptionsInUnits(double m) const {
+  BearingOnlyTrackerOptions f = options_.filter;
+  const double u = 1.0 / m;  // units per metre
+  f.init_depth_min *= u;
+  f.init_depth_max *= u;
+  f.init_speed_min *= u;
+  f.init_speed_max *= u;
+  f.accel_sigma *= u;
+  f.position_sigma *= u;
+  f.min_depth *= u;
+  f.ground_height_tolerance *= u;
+  f.ground_height_sigma *= u;
+  f.below_ground_tolerance *= u;
+  f.max_ground_clearance *= u;
+  f.max_object_height *= u;
+  f.volumes.accel_margin *= u;
+  return f;
+}
+
+ObjectExtentOptions ObjectTracking::ExtentOptionsInUnits(double m) const {
+  ObjectExtentOptions e = options_.extent;
+  e.min_size /= m;
+  e.max_size /= m;
+  return e;
+}
+
+Eigen::Vector2d ObjectTracking::MoveReference(State* s, const ObjectObservation& o, bool* restarted) const {
+  std::vector<double> dx, dy;
+  for (size_t i = 0; i < o.track_ids.size(); ++i) {
+    auto it = s->last_xy.find(o.track_ids[i]);
+    if (it == s->last_xy.end()) continue;
+    dx.push_back(o.track_xy[i].x() - it->second.x());
+    dy.push_back(o.track_xy[i].y() - it->second.y());
+  }
+  *restarted = dx.empty();
+  const Eigen::Vector2d centroid = Centroid(o.track_xy);
+  Eigen::Vector2d ref = centroid;
+  if (!dx.empty()) {
+    ref = s->reference_xy + Eigen::Vector2d(Median(dx), Median(dy));
+    ref += options_.reference_centroid_pull * (centroid - ref);
+    Eigen::Vector2d lo = o.track_xy.front(), hi = o.track_xy.front();
+    for (const Eigen::Vector2d& p : o.track_xy) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    ref = ref.cwiseMax(lo).cwiseMin(hi);
+  }
+  s->last_xy.clear();
+  for (size_t i = 0; i < o.track_ids.size(); ++i) s->last_xy[o.track_ids[i]] = o.track_xy[i];
+  return ref;
+}
+
+const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& frame) {
+  out_.clear();
+  if (!options_.enabled) return out_;
+  if (frame.rescaled_by) {
+    for (auto& [id, s] : objects_) {
+      s.filter.RescaleWorld(*frame.rescaled_by);
+      s.extent.RescaleWorld(*frame.rescaled_by);
+      s.metres_per_unit /= *frame.rescaled_by;
+    }
+  }
+  if (!frame.pose_valid) {
+    // Without the static pose no bearing can be placed in the world; filters wait.
+    return out_;
+  }
+  std::optional<Eigen::Vector3d> up;
+  if (frame.ground) up = frame.ground->normal;
+  const Eigen::Vector3d up_or_camera =
+      up ? *up : Eigen::Vector3d(frame.cam_from_world.Inverse().rotation * Eigen::Vector3d(0, -1, 0));
+
+  std::map<int, bool> seen;  // persistent ids observed in this image
+  for (const ObjectObservation& o : frame.objects) {
+    if (static_cast<int>(o.track_xy.size()) < options_.min_tracks || o.track_xy.size() != o.track_ids.size()) continue;
+    int id = 0;
+    auto known = object_of_segment_.find(o.id);
+    if (known != object_of_segment_.end() && !seen.count(known->second)) {
+      id = known->second;
+    } else {
+      id = Reidentify(frame, o, seen);
+      if (id != 0) ++stats_.reidentified;
+    }
+    if (id == 0) id = next_id_++;
+    auto it = objects_.find(id);
+    if (it == objects_.end()) {
+      const double m = MetresPerUnit(frame);
+      it = objects_.emplace(std::piecewise_construct, std::forward_as_tuple(id),
+                            std::forward_as_tuple(FilterOptionsInUnits(m), ExtentOptionsInUnits(m), id))
+               .first;
+      it->second.metres_per_unit = m;
+    }
+    object_of_segment_[o.id] = id;
+    State& s = it->second;
+    s.segment_id = o.id;
+    bool restarted = false;
+    const Eigen::Vector2d ref = MoveReference(&s, o, &restarted);
+    if (restarted && s.filter.initialized()) ++stats_.reference_restarts;
+    s.reference_xy = ref;
+
+    BotObservation b;
+    b.utime = frame.utime;
+    b.cam_from_world = frame.cam_from_world;
+    b.focal_px = frame.focal_px;
+    b.xy = ref;
+    b.track_xy = o.track_xy;
+    b.ground_plane = frame.ground;
+    if (o.background_depth && std::isfinite(o.background_depth->max)) {
+      b.depth_bound = DepthRange{0.0, o.background_depth->max * (1.0 + options_.depth_bound_margin)};
+    }
+    Status st;
+    bool from_static = false;
+    if (!s.filter.initialized()) {
+      from_static =
+          !o.mapped_points.empty() &&
+          static_cast<double>(o.mapped_points.size()) >= options_.static_point_min_share * o.track_ids.size();
+      if (from_static) {
+        // Sec. 5.1.2: a previously static object starts at its known depth. The reference
+        // bearing is the centroid: its point is placed at the mapped points' median depth.
+        std::vector<double> z;
+        for (const Eigen::Vector3d& p : o.mapped_points) z.push_back((frame.cam_from_world * p).z());
+        const double depth = Median(z);
+        if (depth > 0.0) {
+          const Eigen::Vector3d point = frame.cam_from_world.Inverse() * Eigen::Vector3d(Eigen::Vector3d(ref.x(), ref.y(), 1.0) * depth);
+          st = s.filter.InitializeFromPoint(b, point);
+          if (st.ok()) ++stats_.filters_from_static;
+        } else {
+          st = s.filter.Initialize(b);
+        }
+      } else {
+        st = s.filter.Initialize(b);
+      }
+      if (st.ok()) {
+        ++stats_.filters_started;
+        MBSLAM_LOG(INFO) << "object " << id << ": filter started, " << s.metres_per_unit << " m per map unit, "
+                         << (frame.ground ? "ground plane" : "no ground plane") << ", depth bound "
+                         << (b.depth_bound ? std::to_string(b.depth_bound->max) : std::string("none"))
+                         << (from_static ? ", previously static" : "");
+      }
+    } else {
+      st = s.filter.Update(b);
+    }
+    if (!st.ok()) {
+      ++stats_.rejected_updates;
+      MBSLAM_LOG(DEBUG) << "object " << id << " (segment " << o.id << "): " << st.message();
+      continue;
+    }
+    s.last_seen_utime = frame.utime;
+    const BotEstimate e = s.filter.Estimate();
+    if (e.valid) s.extent.Update(frame.cam_from_world, o.track_xy, ref, e.depth, up_or_camera);
+    seen[id] = true;
+  }
+
+  for (auto it = objects_.begin(); it != objects_.end();) {
+    State& s = it->second;
+    const bool now = seen.count(it->first) > 0;
+    if (!now) {
+      if (!s.filter.initialized() || frame.utime - s.last_seen_utime > options_.keep_unseen_us) {
+        ++stats_.filters_dropped;
+        for (auto m = object_of_segment_.begin(); m != object_of_segment_.end();) {
+          m = m->second == it->first ? object_of_segment_.erase(m) : std::next(m);
+        }
+        it = objects_.erase(it);
+        continue;
+      }
+      if (s.filter.utime() < frame.utime) (void)s.filter.Predict(frame.utime, frame.ground);
+    }
+    TrackedObject t;
+    t.id = it->first;
+    t.seen = now;
+    t.segment_id = now ? s.segment_id : 0;
+    t.last_seen_utime = s.last_seen_utime;
+    t.reference_xy = s.reference_xy;
+    t.estimate = s.filter.Estimate();
+    t.extent = s.extent.extent();
+    t.center = t.estimate.world_from_object.translation + (t.extent.valid ? t.extent.center_offset : Eigen::Vector3d::Zero());
+    t.volumes = s.filter.PredictVolumes(t.extent);
+    // The filter's boxes surround its reference points; the object's centre is offset.
+    if (t.extent.valid) {
+      for (PredictedVolume& v : t.volumes) v.center += t.extent.center_offset;
+    }
+    t.metres_per_unit = s.metres_per_unit;
+    if (t.estimate.valid) out_.push_back(std::move(t));
+    ++it;
+  }
+  return out_;
+}
+
+}  // namespace mbslam
