@@ -163,13 +163,19 @@ cv::Mat MovingRegion(const PerceptionFrame& frame, cv::Size size, RegionSource* 
 }
 
 double ConvexHullIoU(const cv::Mat& mask) {
-  std::vector<cv::Point> nz, hull;
-  cv::findNonZero(mask, nz);
-  if (nz.size() < 3) return nz.empty() ? 1.0 : 0.0;
-  cv::convexHull(nz, hull);
-  std::vector<cv::Point2f> poly;
-  for (const cv::Point& p : hull) poly.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
-  return RegionIoU(RasterizePolygons({poly}, mask.size()), mask);
+  if (cv::countNonZero(mask) == 0) return 1.0;
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  std::vector<std::vector<cv::Point>> hulls;
+  for (const auto& c : contours) {
+    std::vector<cv::Point> hull;
+    cv::convexHull(c, hull);
+    hulls.push_back(std::move(hull));
+  }
+  cv::Mat region(mask.size(), CV_8UC1, cv::Scalar(0));
+  cv::fillPoly(region, hulls, cv::Scalar(255));
+  for (const auto& h : hulls) cv::polylines(region, std::vector<std::vector<cv::Point>>{h}, true, cv::Scalar(255));
+  return RegionIoU(region, mask);
 }
 
 MaskFrameScore ScoreMaskFrame(const PerceptionFrame* frame, const cv::Mat& mask) {

@@ -83,8 +83,9 @@ cv::Mat MovingRegion(const PerceptionFrame& frame, cv::Size size, RegionSource* 
 
 // ---------------------------------------------------------------- DAVIS-style mask scoring
 
-// IoU of a mask with its own convex hull: the J a perfect hull-shaped region could reach
-// (context for hull-based J; 1 for a convex mask, 1 for an empty one).
+// IoU of a mask with the union of the convex hulls of its connected parts: the J a region
+// made of one perfect hull per object could reach (context for hull-based J; 1 for convex
+// parts and for an empty mask).
 double ConvexHullIoU(const cv::Mat& mask);
 
 // One image. Precision is undefined (NaN) when no feature is labelled moving; recall is

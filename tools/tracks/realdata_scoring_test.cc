@@ -172,6 +172,10 @@ TEST(RealDataScoring, ConvexHullIoUCeiling) {
   EXPECT_GT(iou, 1200.0 / 1420.0 - 0.01);
   EXPECT_LT(iou, 1200.0 / 1380.0 + 0.01);
   EXPECT_DOUBLE_EQ(ConvexHullIoU(cv::Mat(10, 10, CV_8UC1, cv::Scalar(0))), 1.0);
+  // Two separate squares: one hull each, exactly the mask.
+  cv::Mat two = SquareMask(5, 5, 10);
+  two(cv::Rect(70, 70, 20, 20)).setTo(255);
+  EXPECT_DOUBLE_EQ(ConvexHullIoU(two), 1.0);
 }
 
 TEST(RealDataScoring, RegionSourceFallbacks) {
