@@ -52,6 +52,7 @@ struct PerceptionOptions {
   GroundPlaneOptions ground;
   OccupancyMapOptions occupancy;
   bool occupancy_enabled = true;
+  int64_t occupancy_publish_period_us = 1000000;
   ObjectTrackingOptions objects;
 
   CoreOptions core() const {
@@ -65,6 +66,7 @@ struct PerceptionOptions {
     c.ground = ground;
     c.occupancy = occupancy;
     c.occupancy_enabled = occupancy_enabled;
+    c.occupancy_publish_period_us = occupancy_publish_period_us;
     c.objects = objects;
     // Lockstep replays must be deterministic: bundle adjustment runs inline there.
     if (pipeline.lockstep()) c.slam.background_ba = false;
@@ -85,6 +87,7 @@ struct PerceptionOptions {
     MBSLAM_CHECK_OPTION_SECTION(ground);
     MBSLAM_CHECK_OPTION_SECTION(occupancy);
     MBSLAM_CHECK_OPTION_SECTION(objects);
+    MBSLAM_CHECK_OPTION_GE(occupancy_publish_period_us, 0);
     return true;
   }
   template <typename V>
@@ -101,6 +104,8 @@ struct PerceptionOptions {
     v("slam", &slam, "static-world keyframe SLAM (thesis ch. 4)");
     v("ground", &ground, "ground plane from the static map (sec. 5.1.1)");
     v("occupancy_enabled", &occupancy_enabled, "build and publish the static-world occupancy map");
+    v("occupancy_publish_period_us", &occupancy_publish_period_us,
+      "PERCEPTION_OCCUPANCY at most this often, at keyframes (us)");
     v("occupancy", &occupancy, "OctoMap occupancy of the static world (sec. 6.3)");
     v("objects", &objects, "bearing-only tracking of moving objects, extent, predicted volumes (ch. 5-6)");
   }

@@ -35,6 +35,7 @@ void PerceptionCore::Reset() {
   slam_.Reset();
   ground_.reset();
   occupancy_.reset();
+  last_occupancy_publish_utime_.reset();
   object_tracking_.Reset();
   tracker_.Reset();
   segmenter_.Reset();
@@ -190,6 +191,9 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
   }
   occupancy_->InsertRays(kf->cam_from_world.Inverse().translation, points);
   if (!occupancy_->IsResolutionFixed()) return;
+  // Serialising a large tree costs tens of ms: publish at most once per period.
+  if (last_occupancy_publish_utime_ && utime - *last_occupancy_publish_utime_ < options_.occupancy_publish_period_us) return;
+  last_occupancy_publish_utime_ = utime;
   OccupancyOutput out;
   out.utime = utime;
   out.scale_state = slam_.metric() ? ScaleState::kMetric : ScaleState::kUpToScale;

@@ -102,6 +102,7 @@ struct CoreOptions {
   GroundPlaneOptions ground;
   OccupancyMapOptions occupancy;
   bool occupancy_enabled = true;      // build and publish the static-world occupancy map
+  int64_t occupancy_publish_period_us = 1000000;  // PERCEPTION_OCCUPANCY at most this often, at keyframes (µs)
   ObjectTrackingOptions objects;
   int map_publish_every_frames = 15;  // PERCEPTION_MAP at most this often, and at every keyframe
   double ground_depth_margin = 0.15;  // depth bound from the ground: static points lie above it (fraction)
@@ -152,6 +153,7 @@ class PerceptionCore : public FrameProcessor {
   std::optional<GroundPlane> ground_;
   ObjectTracking object_tracking_;
   std::unique_ptr<OccupancyMap> occupancy_;  // static world only (sec. 6.3); null until rays arrive
+  std::optional<int64_t> last_occupancy_publish_utime_;
   int64_t last_map_publish_frame_ = -1000000;
   std::vector<cv::Mat> pyramid_;
   std::map<int64_t, int64_t> frame_utime_;   // frame index -> image time (recent frames)
