@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/util/atomic_file.h"
+#include "common/util/request_path.h"
 
 namespace mbslam {
 namespace viewer {
@@ -69,22 +70,12 @@ Status WritePngAtomically(const std::string& path, const cv::Mat& bgr) {
 
 Status ResolveRequestPrefix(const std::string& output_dir, const std::string& request_prefix,
                             bool allow_any_path, std::string* prefix) {
-  const std::string base = output_dir.empty() ? std::string("./") : output_dir + "/";
-  *prefix = base;
-  if (request_prefix.empty()) return Status::Ok();
-  const std::filesystem::path p(request_prefix);
-  bool has_dot_dot = false;
-  for (const auto& part : p) has_dot_dot = has_dot_dot || part == "..";
-  if (p.is_absolute() || has_dot_dot) {
-    if (!allow_any_path) {
-      return Status::Error("snapshot request path prefix '" + request_prefix +
-                           "' leaves the output directory (viewer.allow_request_paths is off)");
-    }
-    *prefix = request_prefix;
-    return Status::Ok();
+  const Status s = ResolveRequestPath(output_dir, request_prefix, allow_any_path, prefix);
+  if (!s.ok()) {
+    return Status::Error("snapshot request path prefix: " + s.message() +
+                         (allow_any_path ? "" : " (viewer.allow_request_paths is off)"));
   }
-  *prefix = base + request_prefix;
-  return Status::Ok();
+  return s;
 }
 
 }  // namespace viewer

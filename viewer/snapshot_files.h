@@ -31,10 +31,11 @@ Status LinkAtomically(const std::string& target, const std::string& path);
 // EncodePng + WriteBytesAtomically.
 Status WritePngAtomically(const std::string& path, const cv::Mat& bgr);
 
-// Where the files of a snapshot request go. An empty request prefix means
-// "<output_dir>/". A relative prefix without ".." is placed under output_dir; an
-// absolute one or one with ".." is honoured only when allow_any_path is set, else it is
-// refused (Status error; the caller then uses "<output_dir>/").
+// Where the files of a snapshot request go (ResolveRequestPath, common/util/
+// request_path.h). An empty request prefix means "<output_dir>/". A relative prefix
+// without ".." is placed under output_dir; an absolute one or one with ".." is honoured
+// only when allow_any_path is set, else it is refused (Status error; the caller then
+// uses "<output_dir>/"); control characters are always refused.
 Status ResolveRequestPrefix(const std::string& output_dir, const std::string& request_prefix,
                             bool allow_any_path, std::string* prefix);
 

@@ -199,9 +199,51 @@ std::string FormatDoubleArray(const double* values, size_t count) {
 
 }  // namespace internal
 
+Status CheckYamlTextIsUtf8(const std::string& text, const std::string& what) {
+  const auto* p = reinterpret_cast<const unsigned char*>(text.data());
+  const size_t n = text.size();
+  size_t line = 1;
+  for (size_t i = 0; i < n;) {
+    const unsigned char c = p[i];
+    if (c < 0x80) {
+      if (c == '\n') ++line;
+      ++i;
+      continue;
+    }
+    // Lead byte: the number of continuation bytes and the smallest code point that
+    // needs them (shorter encodings are overlong).
+    size_t extra = 0;
+    uint32_t min = 0;
+    if ((c & 0xE0) == 0xC0) {
+      extra = 1;
+      min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+      extra = 2;
+      min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+      extra = 3;
+      min = 0x10000;
+    }
+    bool ok = extra > 0 && n - i > extra;
+    uint32_t code = c & (0x3Fu >> extra);
+    for (size_t k = 1; ok && k <= extra; ++k) {
+      ok = (p[i + k] & 0xC0) == 0x80;
+      code = (code << 6) | (p[i + k] & 0x3Fu);
+    }
+    ok = ok && code >= min && code <= 0x10FFFF && !(code >= 0xD800 && code <= 0xDFFF);
+    if (!ok) {
+      return Status::Error(what + ": line " + std::to_string(line) +
+                           " is not UTF-8 text (YAML must be UTF-8)");
+    }
+    i += extra + 1;
+  }
+  return Status::Ok();
+}
+
 Status ReadYamlFile(const std::string& path, YAML::Node* root) {
   std::string text;
   MBSLAM_RETURN_IF_ERROR(ReadFileToString(path, &text, size_t{16} << 20));
+  MBSLAM_RETURN_IF_ERROR(CheckYamlTextIsUtf8(text, path));
   try {
     *root = YAML::Load(text);
   } catch (const YAML::Exception& e) {

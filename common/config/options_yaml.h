@@ -133,6 +133,12 @@ class YamlWriter {
 
 }  // namespace internal
 
+// YAML text must be UTF-8 (YAML 1.2). yaml-cpp loads other bytes as they are but its
+// emitter writes them back as U+FFFD, so a file that loaded would not read back the
+// same from --print-config / CameraIntrinsicsToYaml. `what` names the text in the
+// error ("calibration", a file name).
+Status CheckYamlTextIsUtf8(const std::string& text, const std::string& what);
+
 // Fills `options` from a YAML mapping; missing keys keep their defaults. Fails on
 // unknown keys, values of the wrong type, non-finite numbers, and a failed Check().
 // On failure `options` is left unchanged.
@@ -151,6 +157,7 @@ Status LoadOptionsFromYaml(const YAML::Node& node, const std::string& section, T
 // Parses YAML text (not a file name) into options.
 template <typename T>
 Status LoadOptionsFromYamlText(const std::string& text, const std::string& section, T* options) {
+  MBSLAM_RETURN_IF_ERROR(CheckYamlTextIsUtf8(text, "options"));
   YAML::Node root;
   try {
     root = YAML::Load(text);

@@ -120,5 +120,27 @@ TEST(OptionsYaml, WrittenYamlReadsBackIdentically) {
   EXPECT_NE(text.find("# features (count)"), std::string::npos);
 }
 
+// Regression (fuzz_calibration_yaml, issue 9): bytes that are not UTF-8 loaded as they
+// were but were written back as U+FFFD, so a config or calibration that loaded did not
+// read back the same. Such text is an error naming the line.
+TEST(OptionsYaml, TextMustBeUtf8) {
+  OuterOptions o;
+  EXPECT_TRUE(LoadOptionsFromYamlText("name: \"caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x93\xb7\"\n", "", &o).ok());
+  EXPECT_EQ(o.name, "caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x93\xb7");
+  for (const std::string& bad : {std::string("max_features: 3\nname: cam\xfe\n"),  // not a lead byte
+                                std::string("name: \xc3\n"),                      // cut short
+                                std::string("name: \xc0\xaf\n"),                 // overlong '/'
+                                std::string("name: \xed\xa0\x80\n"),            // surrogate
+                                std::string("name: \xf4\x90\x80\x80\n")}) {    // above U+10FFFF
+    OuterOptions x;
+    const Status s = LoadOptionsFromYamlText(bad, "", &x);
+    EXPECT_FALSE(s.ok()) << bad;
+    EXPECT_NE(s.message().find("not UTF-8"), std::string::npos) << s.message();
+    EXPECT_EQ(x.name, "cam0");
+  }
+  EXPECT_NE(CheckYamlTextIsUtf8("a: 1\nb: \xff\n", "f.yaml").message().find("f.yaml: line 2"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace mbslam

@@ -237,6 +237,12 @@ class Walker {
     if (data_[pos_ + static_cast<size_t>(len) - 1] != 0) {
       return Status::Error(schema.name + "." + f.name + ": string not NUL-terminated");
     }
+    // LCM strings are C strings: lcm-gen's C++ decoder keeps bytes after an inner NUL,
+    // but its encoder stops at the first one while getEncodedSize() counts them all,
+    // so such a string re-published or logged leaves unwritten bytes in the message.
+    if (len > 1 && std::memchr(data_ + pos_, 0, static_cast<size_t>(len) - 1) != nullptr) {
+      return Status::Error(schema.name + "." + f.name + ": string with a NUL byte inside");
+    }
     pos_ += static_cast<size_t>(len);
     return Status::Ok();
   }

@@ -6,8 +6,8 @@
 // claims and only then check that the bytes exist, so a corrupt length field can
 // make them allocate gigabytes. The checker walks the encoding with the schema of the
 // .lcm files (embedded into the binary at build time) and rejects any array or string
-// longer than the bytes that remain, negative lengths, missing NUL terminators, a
-// wrong type fingerprint and trailing garbage.
+// longer than the bytes that remain, negative lengths, missing NUL terminators, NUL
+// bytes inside strings, a wrong type fingerprint and trailing garbage.
 
 #include <cstddef>
 #include <cstdint>

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <sstream>
 
@@ -90,6 +91,33 @@ TEST(WireCheck, OversizedMessageIsRejected) {
   std::vector<uint8_t> big(1000, 0);
   mbslam::image_t out;
   EXPECT_FALSE(DecodeLcmMessage(big.data(), big.size(), &out, /*max_size=*/100).ok());
+}
+
+// Regression (fuzz_lcm_decode, issue 9): a string with a NUL inside decoded to a longer
+// std::string than lcm-gen's encoder writes back (it stops at the first NUL while
+// getEncodedSize() counts every byte), so a re-published or logged copy of the message
+// was malformed and carried unwritten buffer bytes. Such strings are rejected.
+TEST(WireCheck, StringWithAnInnerNulIsRejected) {
+  mbslam::snapshot_request_t r;
+  r.utime = 1;
+  r.path_prefix = std::string("snap\0/x", 7);
+  r.what = 4;
+  std::vector<uint8_t> bytes(static_cast<size_t>(r.getEncodedSize()));
+  r.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  // What a sender that copies the bytes (not lcm-gen's encoder) puts on the wire.
+  const size_t len_pos = 8 + 8;
+  bytes[len_pos + 3] = 8;
+  std::copy_n("snap\0/x", 8, bytes.begin() + static_cast<long>(len_pos + 4));
+  mbslam::snapshot_request_t out;
+  const Status s = DecodeLcmMessage(bytes.data(), bytes.size(), &out);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("NUL byte inside"), std::string::npos) << s.message();
+
+  r.path_prefix = "snap/x";
+  std::vector<uint8_t> good(static_cast<size_t>(r.getEncodedSize()));
+  r.encode(good.data(), 0, static_cast<int>(good.size()));
+  ASSERT_TRUE(DecodeLcmMessage(good.data(), good.size(), &out).ok());
+  EXPECT_EQ(out.path_prefix, "snap/x");
 }
 
 }  // namespace

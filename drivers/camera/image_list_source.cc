@@ -103,7 +103,8 @@ SourceStatus ApplyTimestampsFile(const std::string& path, const std::string& uni
       target = sequential++;
     } else if (f.size() == 2) {
       if (AllDigits(f[0])) {
-        target = static_cast<size_t>(std::stoull(f[0]));
+        // An index beyond the images (std::stoull threw out_of_range on 20+ digits).
+        target = f[0].size() > 9 ? n : static_cast<size_t>(std::stoul(f[0]));
       } else {
         auto it = by_name.find(fs::path(f[0]).filename().string());
         if (it == by_name.end()) {
@@ -142,6 +143,11 @@ bool ParseKittiDateTime(const std::string& text, int64_t* utime) {
   int consumed = 0;
   if (std::sscanf(text.c_str(), "%d-%d-%d %d:%d:%d%n", &year, &month, &day, &hour, &minute,
                   &second, &consumed) != 6) {
+    return false;
+  }
+  // Out-of-range fields overflowed year - 1900 and seconds * 1e6.
+  if (year < 1900 || year > 9999 || month < 1 || month > 12 || day < 1 || day > 31 || hour < 0 ||
+      hour > 23 || minute < 0 || minute > 59 || second < 0 || second > 60) {
     return false;
   }
   std::tm tm = {};

@@ -214,6 +214,40 @@ TEST(Kitti, RawLayoutWithDateTimes) {
   EXPECT_EQ(frames[1].utime - frames[0].utime, 103713);
 }
 
+// Regression (issue 9): a 25-digit frame index made std::stoull throw out of the
+// driver; out-of-range date fields overflowed year - 1900 and seconds * 1e6.
+TEST(DatasetTimes, OutOfRangeFieldsAreConfigErrorsNotCrashes) {
+  const std::string dir = MakeTempDir("stamps_range");
+  for (int i = 0; i < 2; ++i) cv::imwrite(dir + "/" + std::to_string(i) + ".png", MakeTestImage(8, 8, 1, i));
+  FolderOptions options;
+  options.timestamps_file = dir + "/t.txt";
+  for (const std::string& bad : {std::string("0 1\n1234567890123456789012345 2\n"),
+                                 std::string("0 1\n4294967296 2\n")}) {
+    WriteTextFile(options.timestamps_file, bad);
+    ImageListSource folder("folder", dir, options, GroundTruthOptions());
+    SourceStatus st;
+    ASSERT_NO_THROW(st = folder.Open()) << bad;
+    EXPECT_EQ(st.kind(), SourceError::kConfig) << bad;
+  }
+
+  const std::string kitti = MakeTempDir("kitti_range");
+  fs::create_directories(kitti + "/image_02/data");
+  for (int i = 0; i < 2; ++i) {
+    cv::imwrite(kitti + "/image_02/data/" + testing_util::FrameName(i, ".png").insert(0, "0000"),
+                MakeTestImage(12, 8, 3, i));
+  }
+  for (const std::string& bad :
+       {std::string("-2147483648-01-01 00:00:00\n-2147483647-01-01 00:00:00\n"),
+        std::string("2147483647-01-01 00:00:00\n2147483647-01-02 00:00:00\n"),
+        std::string("2011-13-26 13:02:25\n2011-09-26 13:02:26\n"),
+        std::string("2011-09-26 13:02:25.5e300\n2011-09-26 13:02:26\n")}) {
+    WriteTextFile(kitti + "/image_02/timestamps.txt", bad);
+    ImageListSource source("kitti", kitti, FolderOptions(), GroundTruthOptions());
+    const SourceStatus st = source.Open();
+    EXPECT_EQ(st.kind(), SourceError::kConfig) << bad;
+  }
+}
+
 TEST(Kitti, OdometryLayoutWithTimesAndPoses) {
   const std::string root = MakeTempDir("kitti_odo");
   const std::string dir = root + "/sequences/07";

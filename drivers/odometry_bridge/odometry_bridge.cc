@@ -146,26 +146,14 @@ Status OdometryBridge::Run() {
     bus_->Subscribe(
         options_.pose_channel,
         [this](const std::string&, const uint8_t* data, size_t size, int64_t) {
-          mbslam::pose_t pose{};
-          const Status st = DecodeLcmMessage(data, size, &pose);
           OdometrySample s;
-          s.utime = pose.utime;
-          s.frame_id = pose.target_frame;
-          s.child_frame_id = pose.source_frame;
-          s.odom_from_base.translation = Eigen::Vector3d(pose.position[0], pose.position[1], pose.position[2]);
-          bool renormalised = false;
-          if (!st.ok() || !OdometryQuaternion(pose.orientation[1], pose.orientation[2], pose.orientation[3],
-                                              pose.orientation[0], &s.odom_from_base.rotation, &renormalised)
-                               .ok()) {
+          const Status st = OdometryFromPoseMessage(
+              data, size, previous_lcm_pose_ ? &*previous_lcm_pose_ : nullptr,
+              options_.derive_twist, &s);
+          if (!st.ok()) {
             ++stats_.received;
             ++stats_.rejected;
             return;
-          }
-          s.seq = previous_lcm_pose_ ? previous_lcm_pose_->seq + 1 : 0;
-          if (options_.derive_twist && previous_lcm_pose_ && s.utime > previous_lcm_pose_->utime) {
-            TwistFromPoses(previous_lcm_pose_->odom_from_base, s.odom_from_base,
-                           UtimeToSeconds(s.utime - previous_lcm_pose_->utime), &s.linear_velocity,
-                           &s.angular_velocity);
           }
           previous_lcm_pose_ = s;
           lcm_samples_.push_back(s);

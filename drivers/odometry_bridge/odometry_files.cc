@@ -65,13 +65,25 @@ std::string CanonicalColumn(std::string name) {
 
 constexpr int kRos2EchoColumns = 89;
 
+// sec + nanosec (ROS time) to µs. Out-of-range values were undefined behaviour in the
+// double -> int64 cast and the multiplication.
+Status StampToUtime(double sec, double nanosec, int64_t* utime) {
+  constexpr double kMaxSec = 9.0e12;  // int64 µs hold +-9.2e12 s
+  if (!(std::abs(sec) <= kMaxSec) || !(nanosec >= 0.0 && nanosec < 1e9)) {
+    return Status::Error("stamp " + std::to_string(sec) + " s + " + std::to_string(nanosec) +
+                         " ns out of range");
+  }
+  *utime = static_cast<int64_t>(sec) * kUsecPerSec + std::llround(nanosec / 1000.0);
+  return Status::Ok();
+}
+
 Status SampleFromRos2EchoRow(const std::vector<std::string>& f, OdometrySample* s) {
   std::vector<double> v(f.size(), 0.0);
   for (size_t i = 0; i < f.size(); ++i) {
     if (i == 2 || i == 3) continue;  // frame ids
     if (!ParseNumber(f[i], &v[i])) return Status::Error("column " + std::to_string(i + 1) + " ('" + f[i] + "') is not a number");
   }
-  s->utime = static_cast<int64_t>(v[0]) * kUsecPerSec + std::llround(v[1] / 1000.0);
+  MBSLAM_RETURN_IF_ERROR(StampToUtime(v[0], v[1], &s->utime));
   s->frame_id = f[2];
   s->child_frame_id = f[3];
   s->odom_from_base.translation = Eigen::Vector3d(v[4], v[5], v[6]);
@@ -93,6 +105,7 @@ Status ReadOdometryCsv(const std::string& path, std::vector<OdometrySample>* sam
   std::string line;
   int number = 0;
   std::map<std::string, size_t> columns;
+  size_t header_width = 0;  // fields of the header line (columns may repeat a name)
   bool headerless = false;
   bool have_layout = false;
   while (std::getline(in, line)) {
@@ -114,6 +127,7 @@ Status ReadOdometryCsv(const std::string& path, std::vector<OdometrySample>* sam
         headerless = true;
       } else {
         for (size_t i = 0; i < f.size(); ++i) columns[CanonicalColumn(f[i])] = i;
+        header_width = f.size();
         for (const char* need : {"x", "y", "z", "qx", "qy", "qz", "qw"}) {
           if (!columns.count(need)) return Status::Error(where + ": header lacks column '" + need + "'");
         }
@@ -131,7 +145,9 @@ Status ReadOdometryCsv(const std::string& path, std::vector<OdometrySample>* sam
       }
       MBSLAM_RETURN_IF_ERROR(SampleFromRos2EchoRow(f, &s).WithContext(where));
     } else {
-      if (f.size() < columns.size()) return Status::Error(where + ": too few columns");
+      // Compared with the header's width, not the number of distinct names: with a
+      // repeated name the last column's index was past the end of a short row.
+      if (f.size() < header_width) return Status::Error(where + ": too few columns");
       auto num = [&](const std::string& name, double* v) -> Status {
         if (!ParseNumber(f[columns.at(name)], v)) {
           return Status::Error(where + ": column '" + name + "' ('" + f[columns.at(name)] + "') is not a number");
@@ -148,7 +164,7 @@ Status ReadOdometryCsv(const std::string& path, std::vector<OdometrySample>* sam
         double sec = 0, nsec = 0;
         MBSLAM_RETURN_IF_ERROR(num("sec", &sec));
         MBSLAM_RETURN_IF_ERROR(num("nanosec", &nsec));
-        s.utime = static_cast<int64_t>(sec) * kUsecPerSec + std::llround(nsec / 1000.0);
+        MBSLAM_RETURN_IF_ERROR(StampToUtime(sec, nsec, &s.utime).WithContext(where));
       }
       double p[7];
       const char* names[7] = {"x", "y", "z", "qx", "qy", "qz", "qw"};
@@ -197,6 +213,11 @@ Status ReadOdometryTum(const std::string& path, bool derive_twist,
     samples->push_back(s);
   }
   if (derive_twist) DeriveTwists(samples);
+  // Twists derived from far-apart poses a microsecond apart are not finite.
+  for (const OdometrySample& s : *samples) {
+    MBSLAM_RETURN_IF_ERROR(ValidateOdometrySample(s).WithContext(
+        path + ": sample at " + std::to_string(s.utime) + " us"));
+  }
   return Status::Ok();
 }
 
@@ -206,9 +227,11 @@ void DeriveTwists(std::vector<OdometrySample>* samples) {
     const size_t b = i == 0 ? std::min<size_t>(1, samples->size() - 1) : i;
     if (a == b) continue;
     OdometrySample& s = (*samples)[i];
-    TwistFromPoses((*samples)[a].odom_from_base, (*samples)[b].odom_from_base,
-                   UtimeToSeconds((*samples)[b].utime - (*samples)[a].utime), &s.linear_velocity,
-                   &s.angular_velocity);
+    // In double: the difference of two file times can exceed int64.
+    const double dt_s = (static_cast<double>((*samples)[b].utime) -
+                         static_cast<double>((*samples)[a].utime)) * 1e-6;
+    TwistFromPoses((*samples)[a].odom_from_base, (*samples)[b].odom_from_base, dt_s,
+                   &s.linear_velocity, &s.angular_velocity);
   }
 }
 

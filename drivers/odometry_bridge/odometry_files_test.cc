@@ -113,5 +113,32 @@ TEST(OdometryTum, PosesWithDerivedTwists) {
   EXPECT_EQ(s[3].linear_velocity, Eigen::Vector3d::Zero());
 }
 
+// Regression (issue 9): with a repeated column name the header's last index pointed
+// past the end of a shorter row (heap overread); ROS stamps out of int64 range were a
+// double -> int64 overflow; twists derived from poses far apart in space but not in
+// time were infinite and passed on.
+TEST(OdometryFiles, MalformedColumnsStampsAndTwistsAreErrors) {
+  const std::string dir = MakeTempDir("odo_range");
+  std::vector<OdometrySample> s;
+  for (const std::string& text :
+       {std::string("x,x,y,z,qx,qy,qz,qw,utime\n0,0,0,0,0,0,0,1\n"),
+        std::string("sec,nanosec,x,y,z,qx,qy,qz,qw\n1e300,0,0,0,0,0,0,0,1\n"),
+        std::string("sec,nanosec,x,y,z,qx,qy,qz,qw\n1,-5,0,0,0,0,0,0,1\n")}) {
+    WriteTextFile(dir + "/bad.csv", text);
+    EXPECT_FALSE(ReadOdometryCsv(dir + "/bad.csv", &s).ok()) << text;
+  }
+  std::string echo = "1e300,0,odom,base_link,1,2,0,0,0,0,1";
+  for (int i = 0; i < 36 + 6 + 36; ++i) echo += ",0";
+  WriteTextFile(dir + "/echo.csv", echo + "\n");
+  EXPECT_FALSE(ReadOdometryCsv(dir + "/echo.csv", &s).ok());
+
+  WriteTextFile(dir + "/far.tum", "1.000000 0 0 0 0 0 0 1\n1.000001 1e305 0 0 0 0 0 1\n");
+  EXPECT_TRUE(ReadOdometryTum(dir + "/far.tum", false, &s).ok());
+  EXPECT_FALSE(ReadOdometryTum(dir + "/far.tum", true, &s).ok());
+  WriteTextFile(dir + "/span.tum", "-9000000000000 0 0 0 0 0 0 1\n9000000000000 1 0 0 0 0 0 1\n");
+  ASSERT_TRUE(ReadOdometryTum(dir + "/span.tum", true, &s).ok());
+  EXPECT_GT(s[1].linear_velocity.x(), 0.0);
+}
+
 }  // namespace
 }  // namespace mbslam

@@ -3,6 +3,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "common/lcm/wire_check.h"
+#include "mbslam/pose_t.hpp"
+
 namespace mbslam {
 
 Status OdometryQuaternion(double x, double y, double z, double w, Eigen::Quaterniond* q,
@@ -37,6 +40,31 @@ Status ValidateOdometrySample(const OdometrySample& s) {
   for (double v : s.twist_covariance) {
     if (!std::isfinite(v)) return Status::Error("non-finite twist covariance");
   }
+  return Status::Ok();
+}
+
+Status OdometryFromPoseMessage(const uint8_t* data, size_t size, const OdometrySample* previous,
+                               bool derive_twist, OdometrySample* sample) {
+  mbslam::pose_t pose{};
+  MBSLAM_RETURN_IF_ERROR(DecodeLcmMessage(data, size, &pose, size_t{1} << 16));
+  OdometrySample s;
+  s.utime = pose.utime;
+  s.frame_id = pose.target_frame;
+  s.child_frame_id = pose.source_frame;
+  s.odom_from_base.translation = Eigen::Vector3d(pose.position[0], pose.position[1], pose.position[2]);
+  bool renormalised = false;
+  MBSLAM_RETURN_IF_ERROR(OdometryQuaternion(pose.orientation[1], pose.orientation[2],
+                                            pose.orientation[3], pose.orientation[0],
+                                            &s.odom_from_base.rotation, &renormalised));
+  s.seq = previous ? previous->seq + 1 : 0;
+  if (derive_twist && previous && s.utime > previous->utime) {
+    // In double: the difference of two message times can exceed int64.
+    const double dt_s =
+        (static_cast<double>(s.utime) - static_cast<double>(previous->utime)) * 1e-6;
+    TwistFromPoses(previous->odom_from_base, s.odom_from_base, dt_s, &s.linear_velocity,
+                   &s.angular_velocity);
+  }
+  *sample = std::move(s);
   return Status::Ok();
 }
 

@@ -41,6 +41,13 @@ Status ValidateOdometrySample(const OdometrySample& sample);
 Status OdometryQuaternion(double x, double y, double z, double w, Eigen::Quaterniond* q,
                           bool* renormalised);
 
+// A pose_t message (odometry_bridge --input lcm: motion capture and the like) as a
+// sample; with derive_twist and a previous sample, the twist from the two poses. Errors:
+// a message that does not decode (bounds-checked), an orientation that is not a
+// rotation. Callers still run ValidateOdometrySample (positions may be infinite).
+Status OdometryFromPoseMessage(const uint8_t* data, size_t size, const OdometrySample* previous,
+                               bool derive_twist, OdometrySample* sample);
+
 void ToOdometryMessage(const OdometrySample& sample, mbslam::odometry_t* msg);
 Status FromOdometryMessage(const mbslam::odometry_t& msg, OdometrySample* sample);
 

@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <limits>
+#include <vector>
 
 #include "drivers/common/test_util.h"
 #include "drivers/odometry_bridge/odometry_bridge_options.h"
 #include "drivers/odometry_bridge/test_trajectory.h"
+#include "mbslam/pose_t.hpp"
 
 namespace mbslam {
 namespace {
@@ -108,6 +111,41 @@ TEST(Extrinsic, YamlRoundTripAndSimulatorLayout) {
   testing_util::WriteTextFile(dir + "/bad.yaml", "translation: [0.1, 0]\nquaternion: [1, 0, 0, 0]\n");
   EXPECT_FALSE(LoadExtrinsicYaml(dir + "/bad.yaml", &read).ok());
   EXPECT_FALSE(LoadExtrinsicYaml(dir + "/missing.yaml", &read).ok());
+}
+
+// The LCM pose input (odometry_bridge --input lcm), moved out of the bridge's handler so
+// that it can be tested and fuzzed. Regression (issue 9): the twist's time step was
+// utime - previous utime in int64, undefined for times of opposite sign near the ends.
+TEST(OdometryFromPoseMessage, DecodesDerivesTwistsAndSurvivesExtremeTimes) {
+  auto encode = [](int64_t utime, double x, double w) {
+    mbslam::pose_t p{};
+    p.utime = utime;
+    p.target_frame = "odom";
+    p.source_frame = "base_link";
+    p.position[0] = x;
+    p.orientation[0] = w;
+    std::vector<uint8_t> b(static_cast<size_t>(p.getEncodedSize()));
+    p.encode(b.data(), 0, static_cast<int>(b.size()));
+    return b;
+  };
+  OdometrySample a, b;
+  std::vector<uint8_t> m = encode(1000000, 0.0, 1.0);
+  ASSERT_TRUE(OdometryFromPoseMessage(m.data(), m.size(), nullptr, true, &a).ok());
+  EXPECT_EQ(a.frame_id, "odom");
+  m = encode(1100000, 0.1, 1.0);
+  ASSERT_TRUE(OdometryFromPoseMessage(m.data(), m.size(), &a, true, &b).ok());
+  EXPECT_NEAR(b.linear_velocity.x(), 1.0, 1e-9);
+  EXPECT_EQ(b.seq, 1);
+
+  m = encode(std::numeric_limits<int64_t>::min() + 1, 0.0, 1.0);
+  ASSERT_TRUE(OdometryFromPoseMessage(m.data(), m.size(), nullptr, true, &a).ok());
+  m = encode(std::numeric_limits<int64_t>::max(), 1.0, 1.0);
+  ASSERT_TRUE(OdometryFromPoseMessage(m.data(), m.size(), &a, true, &b).ok());
+  EXPECT_TRUE(ValidateOdometrySample(b).ok());
+
+  m = encode(5, 0.0, 0.0);  // zero quaternion
+  EXPECT_FALSE(OdometryFromPoseMessage(m.data(), m.size(), nullptr, true, &a).ok());
+  EXPECT_FALSE(OdometryFromPoseMessage(m.data(), m.size() - 3, nullptr, true, &a).ok());
 }
 
 }  // namespace

@@ -3,8 +3,10 @@
 #include <cstdio>
 
 #include "common/util/logging.h"
+#include "common/util/request_path.h"
 #include "common/util/shutdown.h"
 #include "common/util/time.h"
+#include "mbslam/snapshot_request_t.hpp"
 
 namespace mbslam {
 
@@ -38,12 +40,28 @@ std::unique_ptr<PerceptionService> PerceptionService::Create(const PerceptionOpt
   if (!s->adapter_) return nullptr;
   PerceptionService* self = s.get();
   s->adapter_->set_snapshot_callback([self](const std::string& prefix, int what) {
-    if (what & 4) self->WriteOutputs(prefix.empty() ? self->options_.service.output_dir : prefix);
+    if ((what & mbslam::snapshot_request_t::WHAT_OUTPUTS) == 0) return;
+    const std::string& output_dir = self->options_.service.output_dir;
+    if (prefix.empty()) {
+      self->WriteOutputs(output_dir);
+      return;
+    }
+    // LCM has no authentication: a request names a folder under output_dir, never an
+    // arbitrary place (absolute paths and ".." are refused and counted).
+    std::string dir;
+    const Status where = ResolveRequestPath(output_dir, prefix, /*allow_any_path=*/false, &dir);
+    if (!where.ok()) {
+      self->counters_.Increment("snapshot_request_refused_path");
+      MBSLAM_LOG(WARNING) << "SNAPSHOT_REQUEST refused: " << where.message();
+      return;
+    }
+    self->WriteOutputs(dir);
   });
   s->adapter_->Subscribe(bus, options.channels);
   s->from_log_ = options.service.lcm_url.rfind("file://", 0) == 0;
   s->last_status_wall_ = WallUtime();
   s->pipeline_->Start();
+  s->started_ = true;
   *status = Status::Ok();
   return s;
 }
@@ -109,7 +127,9 @@ Status PerceptionService::Run() {
 }
 
 Status PerceptionService::Finish() {
-  if (finished_) return Status::Ok();
+  // A service whose Create() failed half way (no bus, a bad calibration file) has
+  // nothing to finish; its destructor used to dereference the missing pipeline.
+  if (finished_ || !started_) return Status::Ok();
   finished_ = true;
   pipeline_->Stop();
   last_status_ = pipeline_->BuildStatus(WallUtime());

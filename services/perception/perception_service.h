@@ -62,6 +62,7 @@ class PerceptionService {
   std::unique_ptr<PerceptionPipeline> pipeline_;
   std::unique_ptr<InputAdapter> adapter_;
   bool from_log_ = false;
+  bool started_ = false;   // Create() got to the end (its failures destroy a partial service)
   bool finished_ = false;
   std::atomic<bool> shutdown_{false};
   int64_t last_status_utime_ = 0;

@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
 #include <map>
 
 #include "common/lcm/wire_check.h"
@@ -150,6 +153,55 @@ TEST_F(ServiceRobustness, BadInputOnEveryChannelIsCountedAndServiceKeepsRunning)
   bool degraded_seen = false;
   for (const auto& st : statuses_) degraded_seen |= st.state == mbslam::status_t::STATE_DEGRADED;
   EXPECT_TRUE(degraded_seen || statuses_.size() == 1);
+}
+
+// Issue 9: LCM has no authentication, so SNAPSHOT_REQUEST's path_prefix may only name
+// a folder under service.output_dir; absolute paths and ".." are refused and counted.
+TEST(ServiceSnapshotRequests, PathsOutsideTheOutputDirAreRefused) {
+  const std::string root = ::testing::TempDir() + "/mbslam_snapshot_paths_" + std::to_string(::getpid());
+  std::filesystem::remove_all(root);
+  std::filesystem::create_directories(root + "/out");
+  Status s;
+  auto bus = LcmBus::Create("memq://", &s);
+  ASSERT_TRUE(bus) << s.message();
+  PerceptionOptions options;
+  options.pipeline.mode = "lockstep";
+  options.service.output_dir = root + "/out";
+  auto service = PerceptionService::Create(options, &s, bus.get());
+  ASSERT_TRUE(service) << s.message();
+  std::vector<mbslam::status_t> statuses;
+  bus->Subscribe(options.channels.perception_status,
+                 [&statuses](const std::string&, const uint8_t* d, size_t n, int64_t) {
+                   mbslam::status_t st{};
+                   ASSERT_TRUE(DecodeLcmMessage(d, n, &st).ok());
+                   statuses.push_back(st);
+                 });
+  auto request = [&](const std::string& prefix) {
+    mbslam::snapshot_request_t r{};
+    r.utime = 1;
+    r.path_prefix = prefix;
+    r.what = mbslam::snapshot_request_t::WHAT_OUTPUTS;
+    const std::vector<uint8_t> b = Encode(r);
+    bus->PublishRaw(options.channels.snapshot_request, b.data(), static_cast<unsigned>(b.size()));
+    while (bus->HandleTimeout(0) > 0) {
+    }
+  };
+  request(root + "/absolute");
+  request("../escaped");
+  request("inside");
+  ASSERT_TRUE(service->Finish().ok());
+  while (bus->HandleTimeout(0) > 0) {
+  }
+  EXPECT_FALSE(std::filesystem::exists(root + "/absolute"));
+  EXPECT_FALSE(std::filesystem::exists(root + "/escaped"));
+  EXPECT_TRUE(std::filesystem::exists(root + "/out/inside/camera_trajectory.tum"));
+  ASSERT_FALSE(statuses.empty());
+  int64_t refused = 0;
+  for (const auto& c : statuses.back().counters) {
+    if (c.name == "snapshot_request_refused_path") refused = c.value;
+  }
+  EXPECT_EQ(refused, 2);
+  std::filesystem::remove_all(root);
 }
 
 }  // namespace

@@ -31,6 +31,7 @@
 #include "mbslam/camera_pose_t.hpp"
 #include "mbslam/objects_t.hpp"
 #include "mbslam/occupancy_t.hpp"
+#include "services/perception/occupancy/octree_io.h"
 #include "tools/planner_example/path_checker.h"
 
 namespace {
@@ -41,7 +42,9 @@ namespace planner = mbslam::planner;
 constexpr int kExitFree = 0;
 constexpr int kExitBlocked = 1;
 constexpr int kExitNoAnswer = 2;
-constexpr size_t kMaxOccupancyBytes = size_t{512} << 20;
+// An occupancy message larger than this is dropped undecoded. ReadOctreeBinary's node
+// bound (8 M nodes) needs at most 16 MB of node data.
+constexpr size_t kMaxOccupancyBytes = size_t{64} << 20;
 
 constexpr char kUsage[] =
     "usage: planner_example --lcm-url URL (--path FILE | --waypoints 't x y z; ...')\n"
@@ -152,12 +155,11 @@ Eigen::Quaterniond Quaternion(const double wxyz[4]) {
 void OnOccupancy(const uint8_t* data, size_t size, PerceptionState* state) {
   mbslam::occupancy_t msg{};
   Status st = mbslam::DecodeLcmMessage(data, size, &msg, kMaxOccupancyBytes);
-  auto tree = std::make_shared<octomap::OcTree>(msg.resolution > 0.0 ? msg.resolution : 0.1);
+  std::unique_ptr<octomap::OcTree> tree;
   if (st.ok()) {
-    std::istringstream in(std::string(msg.data.begin(), msg.data.end()));
-    if (!tree->readBinary(in)) {
-      st = Status::Error("occupancy_t.data is not an OctoMap binary tree");
-    }
+    // Bounds-checked: octomap's own readBinary trusts the stream (depth, length, size).
+    st = mbslam::ReadOctreeBinary(msg.data.data(), msg.data.size(), mbslam::OctreeReadLimits(),
+                                  &tree);
   }
   if (!st.ok()) {
     ++state->bad_messages;

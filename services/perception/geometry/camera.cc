@@ -170,6 +170,7 @@ Status ReadMatrixData(const YAML::Node& node, const std::string& name, std::vect
 }  // namespace
 
 Status ParseCameraIntrinsicsYaml(const std::string& text, CameraIntrinsics* intrinsics) {
+  MBSLAM_RETURN_IF_ERROR(CheckYamlTextIsUtf8(text, "calibration"));
   std::string body = text;
   if (body.rfind("%YAML:", 0) == 0) body = body.substr(body.find('\n') + 1);
   YAML::Node root;

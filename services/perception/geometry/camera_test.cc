@@ -78,6 +78,45 @@ TEST(Camera, YamlRoundTripAndOpenCvHeader) {
   EXPECT_FALSE(ParseCameraIntrinsicsYaml("[", &bad).ok());
 }
 
+// Issue 9: a calibration file with a NaN, infinite, zero or negative focal length is
+// rejected with an error that names the problem.
+TEST(Camera, YamlWithBadFocalLengthIsRejectedClearly) {
+  auto yaml = [](const std::string& fx) {
+    return "image_width: 640\nimage_height: 480\ncamera_matrix: {rows: 3, cols: 3, data: [" + fx +
+           ", 0, 320, 0, 500, 240, 0, 0, 1]}\n";
+  };
+  CameraIntrinsics c;
+  ASSERT_TRUE(ParseCameraIntrinsicsYaml(yaml("500"), &c).ok());
+  for (const std::string fx : {"nan", "NaN", "inf", "-inf", "1e999"}) {
+    const Status s = ParseCameraIntrinsicsYaml(yaml(fx), &c);
+    EXPECT_FALSE(s.ok()) << fx;
+    EXPECT_NE(s.message().find("finite"), std::string::npos) << fx << ": " << s.message();
+  }
+  for (const std::string fx : {"0", "-500", "-0"}) {
+    const Status s = ParseCameraIntrinsicsYaml(yaml(fx), &c);
+    EXPECT_FALSE(s.ok()) << fx;
+    EXPECT_NE(s.message().find("focal lengths must be positive"), std::string::npos)
+        << fx << ": " << s.message();
+  }
+  EXPECT_FALSE(ParseCameraIntrinsicsYaml(yaml(".nan"), &c).ok());
+  EXPECT_DOUBLE_EQ(c.fx, 500.0);  // unchanged by the failures
+}
+
+// Regression (fuzz_calibration_yaml, issue 9): a camera name that is not UTF-8 was
+// written back by CameraIntrinsicsToYaml as U+FFFD; such a file is an error.
+TEST(Camera, YamlMustBeUtf8) {
+  const std::string body =
+      "image_width: 640\nimage_height: 480\ncamera_matrix: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n";
+  CameraIntrinsics c;
+  ASSERT_TRUE(ParseCameraIntrinsicsYaml("camera_name: caf\xc3\xa9\n" + body, &c).ok());
+  CameraIntrinsics back;
+  ASSERT_TRUE(ParseCameraIntrinsicsYaml(CameraIntrinsicsToYaml(c), &back).ok());
+  EXPECT_EQ(back.name, c.name);
+  const Status s = ParseCameraIntrinsicsYaml("camera_name: davis_8\xfe" "4x480\n" + body, &c);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("not UTF-8"), std::string::npos) << s.message();
+}
+
 TEST(Camera, ScaledKeepsPixelCentres) {
   const CameraIntrinsics c = Make(DistortionModel::kNone, {});
   const CameraIntrinsics half = c.Scaled(0.5);

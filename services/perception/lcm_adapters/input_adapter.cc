@@ -1,6 +1,7 @@
 #include "services/perception/lcm_adapters/input_adapter.h"
 
 #include <cmath>
+#include <limits>
 
 #include "common/lcm/wire_check.h"
 #include "common/util/logging.h"
@@ -12,6 +13,19 @@
 #include "services/perception/pipeline/image_decode.h"
 
 namespace mbslam {
+namespace {
+
+// a - b, saturated instead of overflowing: times and sequence numbers come from the
+// wire and can be anything (INT64_MAX after a negative time overflowed a - b).
+int64_t SaturatingSub(int64_t a, int64_t b) {
+  int64_t d = 0;
+  if (__builtin_sub_overflow(a, b, &d)) {
+    return a > b ? std::numeric_limits<int64_t>::max() : std::numeric_limits<int64_t>::min();
+  }
+  return d;
+}
+
+}  // namespace
 
 std::unique_ptr<InputAdapter> InputAdapter::Create(const InputOptions& options,
                                                    const PipelineOptions& pipeline_options,
@@ -105,12 +119,13 @@ void InputAdapter::HandleImage(const uint8_t* data, size_t size, int64_t wall_ut
     counters_->Increment("image_timeline_reset");
     raw.timeline_reset = true;
     last_odometry_utime_ = 0;
-  } else if (last_image_utime_ != 0 && raw.utime - last_image_utime_ > 0 &&
-             backwards_streak_ == 0 && raw.seq > last_seq_ + 1 && last_seq_ >= 0) {
-    counters_->Increment(counter::kImageSeqGap, raw.seq - last_seq_ - 1);
+  } else if (last_image_utime_ != 0 && backwards_streak_ == 0 && last_seq_ >= 0 &&
+             SaturatingSub(raw.seq, last_seq_) > 1) {
+    counters_->Increment(counter::kImageSeqGap, SaturatingSub(raw.seq, last_seq_) - 1);
   }
   backwards_streak_ = 0;
-  if (last_image_utime_ != 0 && !raw.timeline_reset && raw.utime - last_image_utime_ > max_frame_gap_us_) {
+  if (last_image_utime_ != 0 && !raw.timeline_reset &&
+      SaturatingSub(raw.utime, last_image_utime_) > max_frame_gap_us_) {
     // Reported; the tracker decides what a gap means for it.
     counters_->Increment(counter::kImageTimeJump);
   }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <mutex>
 
 #include "mbslam/camera_calibration_t.hpp"
@@ -187,6 +188,40 @@ TEST(InputAdapter, OdometryNaNAndTimeBackwardsCounted) {
   EXPECT_EQ(f.counters.Get(counter::kOdometryTimeBackwards), 1);
   EXPECT_EQ(f.counters.Get(counter::kOdometryInvalid), 2);
   EXPECT_EQ(f.counters.Get(counter::kOdometryDecodeError), 1);
+}
+
+// Regression (issue 9): an image whose data holds more than width * height * channels
+// bytes disagrees with its header: a counted drop, like one holding too few.
+TEST(InputAdapter, ImageWithMoreDataThanItsSizeIsACountedDrop) {
+  Fixture f;
+  mbslam::image_t padded = Image(1000, 0);
+  padded.data.resize(padded.data.size() * 3, 1);
+  padded.size = static_cast<int32_t>(padded.data.size());
+  f.Feed(padded);
+  mbslam::image_t huge = Image(2000, 1, 16, 8);
+  huge.width = 8192;  // 8192 x 8 gray announced, 128 bytes sent
+  huge.row_stride = 8192;
+  f.Feed(huge);
+  f.Feed(Image(3000, 2));
+  f.Finish();
+  EXPECT_EQ(f.counters.Get(counter::kImageSizeMismatch), 2);
+  EXPECT_EQ(f.processor.images, (std::vector<int64_t>{3000}));
+}
+
+// Regression (issue 9): times and sequence numbers at the ends of int64 are handled
+// without overflow (utime - last_utime and last_seq + 1 were undefined there).
+TEST(InputAdapter, ExtremeTimesAndSequenceNumbers) {
+  Fixture f;
+  const int64_t max = std::numeric_limits<int64_t>::max();
+  const int64_t min = std::numeric_limits<int64_t>::min();
+  f.Feed(Image(-5000000, max));       // negative time, largest seq
+  f.Feed(Image(max, max));            // time jumps by more than int64 holds
+  f.Feed(Image(min, min));            // back to the smallest: rejected
+  f.Finish();
+  EXPECT_EQ(f.processor.images, (std::vector<int64_t>{-5000000, max}));
+  EXPECT_EQ(f.counters.Get(counter::kImageTimeJump), 1);
+  EXPECT_EQ(f.counters.Get(counter::kImageTimeBackwards), 1);
+  EXPECT_EQ(f.counters.Get(counter::kImageSeqGap), 0);
 }
 
 }  // namespace

@@ -63,10 +63,17 @@ Status ValidateRawImage(const RawImage& raw, int max_dimension) {
     if (raw.row_stride < min_stride) {
       return Status::Error("row_stride " + std::to_string(raw.row_stride) + " < width * channels");
     }
+    // The last row may stop at width * channels; more than height full rows is a
+    // message whose geometry disagrees with its data.
     const int64_t needed = static_cast<int64_t>(raw.row_stride) * (raw.height - 1) + min_stride;
-    if (static_cast<int64_t>(raw.bytes.size()) < needed) {
-      return Status::Error("image has " + std::to_string(raw.bytes.size()) + " bytes, needs " +
-                           std::to_string(needed));
+    const int64_t full = static_cast<int64_t>(raw.row_stride) * raw.height;
+    const int64_t have = static_cast<int64_t>(raw.bytes.size());
+    if (have < needed || have > full) {
+      return Status::Error("image has " + std::to_string(have) + " bytes, " +
+                           std::to_string(raw.width) + "x" + std::to_string(raw.height) +
+                           " with row_stride " + std::to_string(raw.row_stride) + " needs " +
+                           (needed == full ? std::to_string(needed)
+                                           : std::to_string(needed) + ".." + std::to_string(full)));
     }
     return Status::Ok();
   }

@@ -7,7 +7,9 @@
 namespace mbslam {
 
 // Checks the geometry of a raw image against its byte count and the size limit,
-// before anything is allocated from it.
+// before anything is allocated from it: raw pixels need between
+// row_stride * (height - 1) + width * channels and row_stride * height bytes; a
+// compressed file's header must announce the message's width and height.
 Status ValidateRawImage(const RawImage& raw, int max_dimension);
 
 // Decodes raw pixels or a JPEG / PNG file into a gray image (and BGR when the source

@@ -97,5 +97,34 @@ TEST(ImageDecode, LyingHeaderAndGarbageAreRejected) {
   EXPECT_FALSE(ValidateRawImage(huge, 8192).ok());
 }
 
+// Regression (fuzzing, issue 9): a raw image whose data holds more than height full
+// rows disagrees with its geometry and is dropped like one holding too few; a header
+// announcing gigabytes is rejected from the sizes alone, before any allocation.
+TEST(ImageDecode, RawDataMustMatchTheGeometry) {
+  RawImage raw;
+  raw.width = 3;
+  raw.height = 2;
+  raw.row_stride = 4;
+  raw.encoding = ImageEncoding::kGray8;
+  raw.bytes.assign(8, 7);  // two full rows
+  EXPECT_TRUE(ValidateRawImage(raw, 100).ok());
+  raw.bytes.push_back(7);
+  EXPECT_FALSE(ValidateRawImage(raw, 100).ok());
+  raw.encoding = ImageEncoding::kRgb8;
+  raw.row_stride = 9;
+  raw.bytes.assign(18, 1);
+  EXPECT_TRUE(ValidateRawImage(raw, 100).ok());
+  raw.bytes.assign(54, 1);  // three times the pixels of 3x2 RGB
+  EXPECT_FALSE(ValidateRawImage(raw, 100).ok());
+
+  RawImage huge;  // 65535 x 65535 x 3 bytes = 12 GB announced, 16 bytes sent
+  huge.width = 65535;
+  huge.height = 65535;
+  huge.row_stride = 3 * 65535;
+  huge.encoding = ImageEncoding::kBgr8;
+  huge.bytes.assign(16, 0);
+  EXPECT_FALSE(ValidateRawImage(huge, 1 << 20).ok());
+}
+
 }  // namespace
 }  // namespace mbslam
