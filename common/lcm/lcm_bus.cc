@@ -1,5 +1,6 @@
 #include "common/lcm/lcm_bus.h"
 
+#include <cstdio>
 #include <cstdlib>
 
 #include "common/lcm/channels.h"
@@ -35,26 +36,36 @@ bool LcmBus::UrlLeavesHost(const std::string& url) {
   }
   if (effective.empty()) return false;  // LCM's default udpm URL uses ttl=0
   if (effective.rfind("udpm://", 0) != 0) return false;
-  // Find "ttl=<digits>" right after '?' or '&'.
+  // Every "ttl=<value>" option (after '?' or '&'): LCM applies them in order, so any
+  // one above zero is reported. Parsed with strtol (atoi was undefined on overflow).
+  bool leaves = false;
   for (size_t pos = effective.find("ttl="); pos != std::string::npos; pos = effective.find("ttl=", pos + 1)) {
     if (pos == 0 || (effective[pos - 1] != '?' && effective[pos - 1] != '&')) continue;
-    return std::atoi(effective.c_str() + pos + 4) > 0;
+    const long ttl = std::strtol(effective.c_str() + pos + 4, nullptr, 10);
+    leaves = leaves || ttl > 0;
   }
-  return false;
+  return leaves;
+}
+
+std::string LcmBus::ExposureWarning(const std::string& url) {
+  if (!UrlLeavesHost(url)) return "";
+  const std::string shown = url.empty() ? "LCM_DEFAULT_URL=" + std::string(std::getenv("LCM_DEFAULT_URL")) : url;
+  return "WARNING: LCM URL '" + shown +
+         "' has ttl > 0: messages leave this host, and LCM has no authentication (anyone on "
+         "the network can read them and inject inputs); use ttl=0 unless the network is trusted";
 }
 
 std::unique_ptr<LcmBus> LcmBus::Create(const std::string& url, Status* status) {
+  // Printed before opening, whatever the log level: it is about who else can read and
+  // send messages, and it is the configuration that is exposed even if opening fails.
+  const std::string warning = ExposureWarning(url);
+  if (!warning.empty()) std::fputs((warning + "\n").c_str(), stderr);
   auto lcm = std::make_unique<lcm::LCM>(url);
   if (!lcm->good()) {
     *status = Status::Error("cannot open LCM with URL '" + url +
                             "' (for udpm:// check that a multicast route exists; "
                             "for file:// that the log exists)");
     return nullptr;
-  }
-  if (UrlLeavesHost(url)) {
-    MBSLAM_LOG(WARNING) << "LCM URL '" << url
-                        << "' has ttl > 0: messages leave this host and LCM has no "
-                           "authentication; use ttl=0 unless the network is trusted";
   }
   *status = Status::Ok();
   return std::unique_ptr<LcmBus>(new LcmBus(std::move(lcm), url));

@@ -27,7 +27,7 @@ class LcmBus {
                                         size_t size, int64_t recv_utime)>;
 
   // Opens the bus. An empty URL means LCM's default (env LCM_DEFAULT_URL, else udpm).
-  // Warns when a udpm:// URL has ttl > 0 (messages would leave the host).
+  // Prints ExposureWarning(url) on stderr, whatever the log level, when there is one.
   static std::unique_ptr<LcmBus> Create(const std::string& url, Status* status);
 
   ~LcmBus();
@@ -56,8 +56,12 @@ class LcmBus {
   const std::string& url() const { return url_; }
   lcm::LCM& lcm() { return *lcm_; }
 
-  // True when the URL carries udpm:// with a ttl > 0.
+  // True when the URL ("" = LCM_DEFAULT_URL) is udpm:// with a ttl > 0: multicast
+  // leaves this host.
   static bool UrlLeavesHost(const std::string& url);
+  // The stderr warning for such a URL (LCM has no authentication: who can reach the
+  // network can read every message and inject inputs); "" for a URL that stays local.
+  static std::string ExposureWarning(const std::string& url);
 
  private:
   struct Subscription {

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <map>
 
 #include "common/lcm/all_types.h"
 #include "common/lcm/lcm_log.h"
 #include "common/lcm/wire_check.h"
+#include "common/util/logging.h"
 
 namespace mbslam {
 namespace {
@@ -112,6 +114,60 @@ TEST(LcmBus, TtlAboveZeroIsDetected) {
   EXPECT_TRUE(LcmBus::UrlLeavesHost("udpm://239.255.76.67:7667?recv_buf_size=100&ttl=3"));
   EXPECT_FALSE(LcmBus::UrlLeavesHost("memq://"));
   EXPECT_FALSE(LcmBus::UrlLeavesHost("udpm://239.255.76.67:7667"));
+  // LCM applies every ttl option in turn: any above zero counts.
+  EXPECT_TRUE(LcmBus::UrlLeavesHost("udpm://239.255.76.67:7667?ttl=0&ttl=1"));
+  EXPECT_FALSE(LcmBus::UrlLeavesHost("udpm://239.255.76.67:7667?ttl=-1"));
+  EXPECT_FALSE(LcmBus::UrlLeavesHost("udpm://239.255.76.67:7667?xttl=5"));
+  EXPECT_TRUE(LcmBus::UrlLeavesHost("udpm://239.255.76.67:7667?ttl=99999999999999999999"));
+  EXPECT_FALSE(LcmBus::UrlLeavesHost("file:///tmp/x.lcmlog?ttl=1"));
+}
+
+TEST(LcmBus, ExposureWarningNamesTheUrlAndTheRisk) {
+  EXPECT_EQ(LcmBus::ExposureWarning("udpm://239.255.76.67:7667?ttl=0"), "");
+  EXPECT_EQ(LcmBus::ExposureWarning("memq://"), "");
+  const std::string w = LcmBus::ExposureWarning("udpm://239.255.76.67:7667?ttl=1");
+  EXPECT_NE(w.find("WARNING"), std::string::npos);
+  EXPECT_NE(w.find("udpm://239.255.76.67:7667?ttl=1"), std::string::npos);
+  EXPECT_NE(w.find("no authentication"), std::string::npos);
+  EXPECT_NE(w.find("ttl=0"), std::string::npos);
+
+  // An empty URL is LCM_DEFAULT_URL's.
+  const char* saved = std::getenv("LCM_DEFAULT_URL");
+  const std::string saved_value = saved ? saved : "";
+  setenv("LCM_DEFAULT_URL", "udpm://239.255.76.67:7667?ttl=2", 1);
+  EXPECT_NE(LcmBus::ExposureWarning("").find("LCM_DEFAULT_URL=udpm://239.255.76.67:7667?ttl=2"),
+            std::string::npos);
+  unsetenv("LCM_DEFAULT_URL");
+  EXPECT_EQ(LcmBus::ExposureWarning(""), "");
+  if (saved) setenv("LCM_DEFAULT_URL", saved_value.c_str(), 1);
+}
+
+// The warning goes to stderr before the bus opens, even when the log level hides
+// warnings. (300.0.0.1 is not an address: LCM refuses the URL before it creates any
+// socket, so the test stays off the network.)
+TEST(LcmBus, CreateWarnsOnStderrWhateverTheLogLevel) {
+  const LogLevel level = GetLogLevel();
+  SetLogLevel(LogLevel::kError);
+  testing::internal::CaptureStderr();
+  Status status;
+  auto bus = LcmBus::Create("udpm://300.0.0.1:7667?ttl=1", &status);
+  const std::string err = testing::internal::GetCapturedStderr();
+  SetLogLevel(level);
+  EXPECT_FALSE(bus);
+  EXPECT_NE(err.find("WARNING: LCM URL 'udpm://300.0.0.1:7667?ttl=1' has ttl > 0"), std::string::npos)
+      << err;
+}
+
+TEST(LcmBus, CreatePrintsNoWarningForLocalUrls) {
+  const LogLevel level = GetLogLevel();
+  SetLogLevel(LogLevel::kError);
+  testing::internal::CaptureStderr();
+  Status status;
+  auto bus = LcmBus::Create("memq://", &status);
+  const std::string err = testing::internal::GetCapturedStderr();
+  SetLogLevel(level);
+  ASSERT_TRUE(bus);
+  EXPECT_EQ(err, "");
 }
 
 }  // namespace
