@@ -9,3 +9,19 @@ if(MBSLAM_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
+
+# Fuzzing (test/fuzz): coverage for libFuzzer, ASan and UBSan on every project target;
+# the fuzz executables add -fsanitize=fuzzer (its main) when they link.
+set(MBSLAM_FUZZ_LIBFUZZER OFF)
+if(MBSLAM_BUILD_FUZZ)
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(STATUS "mbslam: fuzz targets with libFuzzer, ASan and UBSan")
+    set(MBSLAM_FUZZ_LIBFUZZER ON)
+    add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer
+                        -fno-sanitize-recover=undefined)
+    add_link_options(-fsanitize=address,undefined)
+  else()
+    message(WARNING "mbslam: MBSLAM_BUILD_FUZZ needs clang (CMAKE_CXX_COMPILER=clang++); "
+                    "the fuzz targets are built as corpus replayers instead")
+  endif()
+endif()

@@ -7,7 +7,8 @@
 # Each evaluation is a script scripts/eval.d/NAME.sh whose second line is a
 # "# description". It prints a human summary and, as its LAST line, one JSON object
 # with the figures. Evaluations find the build in $MBSLAM_BUILD (default build/) and
-# write their outputs under $MBSLAM_EVAL_OUT (default out/eval/NAME/).
+# write their outputs under $MBSLAM_EVAL_OUT (default out/eval/NAME/). A script with a
+# line "# eval: own-build" builds what it needs itself (e.g. fuzz, in build-fuzz/).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
@@ -42,6 +43,8 @@ mkdir -p "$MBSLAM_EVAL_OUT"
 
 if [[ "${MBSLAM_EVAL_NO_BUILD:-0}" != "1" ]]; then
   ./scripts/install-deps.sh >/dev/null
+fi
+if [[ "${MBSLAM_EVAL_NO_BUILD:-0}" != "1" ]] && ! grep -q '^# eval: own-build' "$script"; then
   ./scripts/build.sh "$MBSLAM_BUILD" >"$MBSLAM_EVAL_OUT/build.log" 2>&1 || {
     echo "eval.sh: build failed, see $MBSLAM_EVAL_OUT/build.log" >&2
     tail -20 "$MBSLAM_EVAL_OUT/build.log" >&2

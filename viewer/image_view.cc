@@ -120,6 +120,9 @@ void RenderImageView(const ImageViewOptions& options, const ImageViewInput& inpu
   double scale = options.scale;
   if (source_w * scale < options.min_width)
     scale = static_cast<double>(options.min_width) / source_w;
+  // The output's sides stay within kMaxViewDimension: enlarging a 1 x 8192 image (or
+  // tracks of that size) to min_width asked for 640 x 5 M pixels, ~10 GB.
+  scale = std::min(scale, kMaxViewDimension / static_cast<double>(std::max(source_w, source_h)));
   const cv::Size out_size(std::max(1, static_cast<int>(std::lround(source_w * scale))),
                           std::max(1, static_cast<int>(std::lround(source_h * scale))));
   if (canvas.empty()) {

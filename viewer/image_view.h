@@ -17,6 +17,9 @@
 namespace mbslam {
 namespace viewer {
 
+// The largest width or height of a drawn view (px): scale and min_width give way to it.
+inline constexpr int kMaxViewDimension = 8192;
+
 struct ImageViewInput {
   cv::Mat image;                         // BGR camera image; empty = a grey canvas
   const TracksData* tracks = nullptr;    // may be null

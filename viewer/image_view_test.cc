@@ -177,6 +177,28 @@ TEST_F(ImageViewTest, BadValuesAreSkippedAndMissingPartsStillRender) {
   EXPECT_FALSE(out.empty());
 }
 
+// Regression (issue 9, found profiling fuzz_viewer_lcm): tracks or an image 1 px wide
+// and 8192 px tall were enlarged to min_width, a 640 x 5 M pixel canvas (~10 GB).
+TEST_F(ImageViewTest, EnlargingNeverExceedsTheMaximumViewSize) {
+  options_.show_legend = true;
+  options_.min_width = 640;
+  TracksData thin;
+  thin.width = 1;
+  thin.height = 8192;
+  ImageViewInput input;
+  input.tracks = &thin;
+  cv::Mat out;
+  RenderImageView(options_, input, &out);
+  EXPECT_LE(out.cols, kMaxViewDimension);
+  EXPECT_LE(out.rows, kMaxViewDimension + 600);  // header and legend bands
+  input = ImageViewInput();
+  input.image = cv::Mat(4000, 2, CV_8UC3, cv::Scalar(1, 2, 3));
+  options_.scale = 8.0;
+  RenderImageView(options_, input, &out);
+  EXPECT_LE(out.cols, kMaxViewDimension);
+  EXPECT_LE(out.rows, kMaxViewDimension + 600);
+}
+
 TEST_F(ImageViewTest, LegendBandsAndScalingMoveTheImage) {
   options_.show_legend = true;
   options_.scale = 2.0;

@@ -359,8 +359,12 @@ SourceStatus IndexKitti(const std::string& dir, const FolderOptions& options, Im
                                      std::to_string(files.size()) + " images");
     }
     for (size_t i = 0; i < lines.size(); ++i) {
-      const Status parsed = ParseSecondsToUtime(SplitFields(lines[i].second).at(0),
-                                                &index->entries[i].utime);
+      // A line of separators only (",") has no field: SplitFields(...).at(0) threw
+      // std::out_of_range out of camera_driver (found by fuzz_kitti_times).
+      const std::vector<std::string> fields = SplitFields(lines[i].second);
+      const Status parsed = fields.empty()
+                                ? Status::Error("expected a time in seconds")
+                                : ParseSecondsToUtime(fields[0], &index->entries[i].utime);
       if (!parsed.ok()) {
         return SourceStatus::Error(SourceError::kConfig, times + ":" +
                                                              std::to_string(lines[i].first) +

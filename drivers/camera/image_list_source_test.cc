@@ -230,6 +230,20 @@ TEST(DatasetTimes, OutOfRangeFieldsAreConfigErrorsNotCrashes) {
     EXPECT_EQ(st.kind(), SourceError::kConfig) << bad;
   }
 
+  // Found by fuzz_kitti_times: a times.txt line of separators only (",") threw
+  // std::out_of_range out of IndexKitti.
+  const std::string odo = MakeTempDir("kitti_comma") + "/sequences/00";
+  fs::create_directories(odo + "/image_2");
+  for (int i = 0; i < 2; ++i) cv::imwrite(odo + "/image_2/00000" + std::to_string(i) + ".png", MakeTestImage(8, 8, 1, i));
+  WriteTextFile(odo + "/times.txt", "0.0\n,\n");
+  {
+    ImageListSource source("kitti", odo, FolderOptions(), GroundTruthOptions());
+    SourceStatus st;
+    ASSERT_NO_THROW(st = source.Open());
+    EXPECT_EQ(st.kind(), SourceError::kConfig);
+    EXPECT_NE(st.message().find("times.txt:2"), std::string::npos) << st.message();
+  }
+
   const std::string kitti = MakeTempDir("kitti_range");
   fs::create_directories(kitti + "/image_02/data");
   for (int i = 0; i < 2; ++i) {

@@ -11,7 +11,7 @@
 //   map.InsertRays(world_from_cam.translation, new_points_in_world);   // per keyframe
 //   map.Rescale(metres_per_unit, OccupancyMap::Units::kMetres);        // once scale is known
 //   std::string binary;
-//   map.Serialize(&binary);   // occupancy_t.data; readers use OcTree::readBinary
+//   map.Serialize(&binary);   // occupancy_t.data; readers use ReadOctreeBinary (octree_io.h)
 //
 // Units. A monocular map is up to scale until odometry fixes it. While the map is up to
 // scale the voxel edge (and the range bound) are set from the scene: a fraction of the
