@@ -1,60 +1,23 @@
 #include "tools/tracks/misclassification.h"
 
 #include <algorithm>
-#include <limits>
 #include <map>
+
+#include <Eigen/Core>
+
+#include "tools/eval/hungarian.h"
 
 namespace mbslam {
 
 std::vector<int> HungarianAssignment(const std::vector<std::vector<double>>& cost) {
-  // Kuhn-Munkres with potentials, O(n^3); 1-based internal indexing.
-  const int n = static_cast<int>(cost.size());
-  const double inf = std::numeric_limits<double>::max() / 4;
-  std::vector<double> u(n + 1, 0.0), v(n + 1, 0.0);
-  std::vector<int> p(n + 1, 0), way(n + 1, 0);
-  for (int i = 1; i <= n; ++i) {
-    p[0] = i;
-    int j0 = 0;
-    std::vector<double> minv(n + 1, inf);
-    std::vector<bool> used(n + 1, false);
-    do {
-      used[j0] = true;
-      const int i0 = p[j0];
-      double delta = inf;
-      int j1 = 0;
-      for (int j = 1; j <= n; ++j) {
-        if (used[j]) continue;
-        const double cur = cost[i0 - 1][j - 1] - u[i0] - v[j];
-        if (cur < minv[j]) {
-          minv[j] = cur;
-          way[j] = j0;
-        }
-        if (minv[j] < delta) {
-          delta = minv[j];
-          j1 = j;
-        }
-      }
-      for (int j = 0; j <= n; ++j) {
-        if (used[j]) {
-          u[p[j]] += delta;
-          v[j] -= delta;
-        } else {
-          minv[j] -= delta;
-        }
-      }
-      j0 = j1;
-    } while (p[j0] != 0);
-    do {
-      const int j1 = way[j0];
-      p[j0] = p[j1];
-      j0 = j1;
-    } while (j0);
+  // The evaluation toolkit's solver (tools/eval/hungarian.h), on a dense copy.
+  const Eigen::Index rows = static_cast<Eigen::Index>(cost.size());
+  const Eigen::Index cols = rows > 0 ? static_cast<Eigen::Index>(cost[0].size()) : 0;
+  Eigen::MatrixXd m(rows, cols);
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    for (Eigen::Index c = 0; c < cols; ++c) m(r, c) = cost[static_cast<size_t>(r)][static_cast<size_t>(c)];
   }
-  std::vector<int> assignment(n, -1);
-  for (int j = 1; j <= n; ++j) {
-    if (p[j] > 0) assignment[p[j] - 1] = j - 1;
-  }
-  return assignment;
+  return eval::SolveAssignment(m);
 }
 
 double Misclassification(const std::vector<int>& truth, const std::vector<int>& predicted) {
