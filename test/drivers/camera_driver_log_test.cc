@@ -353,7 +353,10 @@ TEST(CameraDriverLog, SigtermDuringPacedPlaybackExitsCleanly) {
   // 2 Hz at recorded speed: 10 s of playback, on an in-process bus (no network).
   testing_util::ChildProcess driver({BinPath("camera_driver"), "--quiet", "--no-progress", "--input", dir,
                                      "--rate", "2", "--speed", "1", "--lcm-url", "memq://"});
-  usleep(700000);
+  // Long enough for the driver to start and install its handler on a loaded machine (a
+  // signal before that kills it: seen at 0.7 s under load average 10); still part-way
+  // through the 10 s of playback.
+  usleep(3000000);
   const int64_t start = MonotonicUtime();
   driver.Signal(SIGTERM);
   const auto r = driver.Wait(5.0);
