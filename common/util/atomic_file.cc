@@ -1,6 +1,8 @@
 #include "common/util/atomic_file.h"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -59,6 +61,28 @@ Status WriteStringAtomically(const std::string& path, const std::string& content
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
     return static_cast<bool>(out);
   });
+}
+
+int RemoveStaleTempFiles(const std::string& dir) {
+  DIR* d = ::opendir(dir.c_str());
+  if (d == nullptr) return 0;
+  int removed = 0;
+  while (const dirent* entry = ::readdir(d)) {
+    const std::string name = entry->d_name;
+    const size_t tag = name.rfind(".tmp.");
+    if (tag == std::string::npos || tag == 0) continue;
+    const std::string pid_text = name.substr(tag + 5);
+    if (pid_text.empty() || pid_text.find_first_not_of("0123456789") != std::string::npos ||
+        pid_text.size() > 9) {
+      continue;
+    }
+    const pid_t pid = static_cast<pid_t>(std::stol(pid_text));
+    // Another process's file: only if that process is gone (ESRCH); EPERM means alive.
+    if (pid == ::getpid() || pid <= 0 || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    if (::unlink((dir + "/" + name).c_str()) == 0) ++removed;
+  }
+  ::closedir(d);
+  return removed;
 }
 
 Status ReadFileToString(const std::string& path, std::string* contents, size_t max_bytes) {

@@ -17,6 +17,10 @@ Status WriteFileAtomically(const std::string& path,
 
 Status WriteStringAtomically(const std::string& path, const std::string& contents);
 
+// Removes the temporary files (`NAME.tmp.PID`) that writers killed mid-write left in
+// `dir`: only those whose process no longer exists. Returns how many were removed.
+int RemoveStaleTempFiles(const std::string& dir);
+
 // Reads a whole file (bounded by max_bytes) into `contents`.
 Status ReadFileToString(const std::string& path, std::string* contents,
                         size_t max_bytes = size_t{1} << 30);

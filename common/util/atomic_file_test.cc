@@ -1,6 +1,7 @@
 #include "common/util/atomic_file.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -45,6 +46,25 @@ TEST(AtomicFile, ReadRespectsLimitAndMissingFile) {
   std::string text;
   EXPECT_FALSE(ReadFileToString(path, &text, 10).ok());
   EXPECT_FALSE(ReadFileToString(path + ".missing", &text).ok());
+}
+
+TEST(AtomicFile, RemovesOnlyTheTempFilesOfDeadWriters) {
+  const std::string dir = TempDir();
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  int status = 0;
+  waitpid(child, &status, 0);  // a writer that is gone
+  const std::string dead = dir + "/map.ply.tmp." + std::to_string(child);
+  const std::string alive = dir + "/map.ply.tmp." + std::to_string(getpid());
+  const std::string parent = dir + "/map.ply.tmp." + std::to_string(getppid());
+  const std::string other = dir + "/notes.tmp.txt";
+  for (const std::string& p : {dead, alive, parent, other}) ASSERT_TRUE(WriteStringAtomically(p, "x").ok());
+  EXPECT_EQ(RemoveStaleTempFiles(dir), 1);
+  std::string text;
+  EXPECT_FALSE(ReadFileToString(dead, &text).ok());
+  EXPECT_TRUE(ReadFileToString(alive, &text).ok());
+  EXPECT_TRUE(ReadFileToString(parent, &text).ok());
+  EXPECT_TRUE(ReadFileToString(other, &text).ok());
 }
 
 }  // namespace

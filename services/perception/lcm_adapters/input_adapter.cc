@@ -1,5 +1,6 @@
 #include "services/perception/lcm_adapters/input_adapter.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -116,7 +117,7 @@ void InputAdapter::HandleImage(const uint8_t* data, size_t size, int64_t wall_ut
       return Reject(counter::kImageTimeBackwards,
                     std::to_string(raw.utime) + " <= " + std::to_string(last_image_utime_));
     }
-    counters_->Increment("image_timeline_reset");
+    counters_->Increment(counter::kImageTimelineReset);
     raw.timeline_reset = true;
     last_odometry_utime_ = 0;
   } else if (last_image_utime_ != 0 && backwards_streak_ == 0 && last_seq_ >= 0 &&
@@ -129,7 +130,7 @@ void InputAdapter::HandleImage(const uint8_t* data, size_t size, int64_t wall_ut
     // Reported; the tracker decides what a gap means for it.
     counters_->Increment(counter::kImageTimeJump);
   }
-  if (raw.seq < last_seq_ && !raw.timeline_reset) counters_->Increment("image_seq_restart");
+  if (raw.seq < last_seq_ && !raw.timeline_reset) counters_->Increment(counter::kImageSeqRestart);
 
   std::shared_ptr<const CameraIntrinsics> intrinsics = intrinsics_;
   if (intrinsics && (intrinsics->width != raw.width || intrinsics->height != raw.height)) {
@@ -137,6 +138,23 @@ void InputAdapter::HandleImage(const uint8_t* data, size_t size, int64_t wall_ut
                   "calibration is " + std::to_string(intrinsics->width) + "x" +
                       std::to_string(intrinsics->height));
   }
+  // Another size than the images before: tracks and map cannot continue across it. A
+  // stray frame is dropped; a lasting change (the calibration says so, or
+  // time_reset_after_frames images in a row) starts a new timeline.
+  if (last_width_ > 0 && (raw.width != last_width_ || raw.height != last_height_)) {
+    const std::string why = std::to_string(raw.width) + "x" + std::to_string(raw.height) + " after " +
+                            std::to_string(last_width_) + "x" + std::to_string(last_height_);
+    if (!intrinsics && ++size_change_streak_ < options_.time_reset_after_frames) {
+      return Reject(counter::kImageSizeChanged, why);
+    }
+    counters_->Increment(counter::kImageSizeChanged);
+    MBSLAM_LOG(WARNING) << "image size changed (" << why << "): starting over";
+    if (!raw.timeline_reset) {
+      counters_->Increment(counter::kImageTimelineReset);
+      raw.timeline_reset = true;
+    }
+  }
+  size_change_streak_ = 0;
   if (!intrinsics) {
     if (options_.fallback_focal_factor <= 0.0) {
       return Reject(counter::kImageUncalibrated, "no calibration and no fallback");
@@ -151,8 +169,23 @@ void InputAdapter::HandleImage(const uint8_t* data, size_t size, int64_t wall_ut
     intrinsics = fallback_;
   }
   raw.intrinsics = std::move(intrinsics);
+  // Odometry that stopped is reported per image until it is back.
+  if (raw.timeline_reset) {
+    if (odometry_clock_utime_ != 0) odometry_clock_utime_ = raw.utime;
+  } else if (odometry_clock_utime_ != 0 && raw.utime > odometry_clock_utime_ &&
+             static_cast<uint64_t>(raw.utime) - static_cast<uint64_t>(odometry_clock_utime_) >
+                 static_cast<uint64_t>(options_.odometry_timeout_us)) {
+    counters_->Increment(counter::kImageWithoutOdometry);
+    if (!odometry_stale_) {
+      MBSLAM_LOG(WARNING) << "no odometry since " << odometry_clock_utime_ << " (image " << raw.utime
+                          << "): images go on without it";
+    }
+    odometry_stale_ = true;
+  }
   last_image_utime_ = raw.utime;
   last_seq_ = raw.seq;
+  last_width_ = raw.width;
+  last_height_ = raw.height;
   pipeline_->Push(InputEvent(std::move(raw)));
 }
 
@@ -223,6 +256,15 @@ void InputAdapter::HandleOdometry(const uint8_t* data, size_t size) {
     counters_->Increment(counter::kOdometryTimeBackwards);
     return;
   }
+  if (odometry_stale_ ||
+      (last_odometry_utime_ != 0 && static_cast<uint64_t>(s.utime) - static_cast<uint64_t>(last_odometry_utime_) >
+                                        static_cast<uint64_t>(options_.odometry_timeout_us))) {
+    counters_->Increment(counter::kOdometryGap);
+    MBSLAM_LOG(WARNING) << "odometry back at " << s.utime << " after a gap since "
+                        << std::max(last_odometry_utime_, odometry_clock_utime_);
+  }
+  odometry_stale_ = false;
+  odometry_clock_utime_ = s.utime;
   last_odometry_utime_ = s.utime;
   s.odom_from_base = Rigid3d(q, t);
   for (int i = 0; i < 3; ++i) {

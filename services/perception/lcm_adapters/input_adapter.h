@@ -26,12 +26,14 @@ struct InputOptions {
   int64_t max_message_bytes = 67108864;  // larger messages are dropped before decoding (bytes)
   int time_reset_after_frames = 15;      // this many consecutive frames with time going back start a new timeline (count)
   int subscription_queue = 100;          // LCM's per-subscription queue (messages)
+  int64_t odometry_timeout_us = 500000;  // once odometry flows, an image this much newer than the last sample counts as without odometry (µs)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(fallback_focal_factor, 0.0);
     MBSLAM_CHECK_OPTION_GT(max_message_bytes, 1024);
     MBSLAM_CHECK_OPTION_GT(time_reset_after_frames, 0);
     MBSLAM_CHECK_OPTION_GT(subscription_queue, 0);
+    MBSLAM_CHECK_OPTION_GT(odometry_timeout_us, 0);
     return true;
   }
   template <typename V>
@@ -42,6 +44,7 @@ struct InputOptions {
     v("max_message_bytes", &max_message_bytes, "larger messages are dropped undecoded (bytes)");
     v("time_reset_after_frames", &time_reset_after_frames, "consecutive backwards frames that start a new timeline (count)");
     v("subscription_queue", &subscription_queue, "LCM per-subscription queue (messages)");
+    v("odometry_timeout_us", &odometry_timeout_us, "image newer than the last odometry by this = without odometry (us)");
   }
 };
 
@@ -83,7 +86,14 @@ class InputAdapter {
   int64_t last_image_utime_ = 0;
   int64_t last_seq_ = -1;
   int backwards_streak_ = 0;
+  int last_width_ = 0;          // size of the last accepted image (px)
+  int last_height_ = 0;
+  int size_change_streak_ = 0;  // consecutive images of another size (count)
   int64_t last_odometry_utime_ = 0;
+  // Message time from which odometry staleness is measured: the last valid sample, or
+  // the start of a new timeline; 0 until odometry was first seen.
+  int64_t odometry_clock_utime_ = 0;
+  bool odometry_stale_ = false;  // images are arriving without odometry
   std::function<void(const std::string&, int)> snapshot_callback_;
 };
 

@@ -61,7 +61,19 @@ inline constexpr const char* kCalibrationDecodeError = "calibration_decode_error
 inline constexpr const char* kCalibrationInvalid = "calibration_invalid";
 inline constexpr const char* kSnapshotDecodeError = "snapshot_request_decode_error";
 inline constexpr const char* kStageOverrun = "stage_overrun";
+inline constexpr const char* kImageTimelineReset = "image_timeline_reset";      // time (or size) changed for good: start over
+inline constexpr const char* kImageSeqRestart = "image_seq_restart";            // seq went back (driver restarted)
+inline constexpr const char* kImageSizeChanged = "image_size_changed";          // size differs from the previous images
+inline constexpr const char* kImageWithoutOdometry = "image_without_odometry";  // odometry seen before, but none recent
+inline constexpr const char* kOdometryGap = "odometry_gap";                     // odometry resumed after a gap
+inline constexpr const char* kTrackingLost = "tracking_lost";                   // camera tracking state left OK
+inline constexpr const char* kTrackingRecovered = "tracking_recovered";         // back to OK after a loss
 }  // namespace counter
+
+// Counters that report recoveries, not problems: they do not make the state DEGRADED.
+inline bool IsInformationalCounter(const std::string& name) {
+  return name == counter::kTrackingRecovered;
+}
 
 }  // namespace mbslam
 

@@ -1,5 +1,7 @@
 #include "services/perception/pipeline/pipeline.h"
 
+#include <limits>
+
 #include "common/util/logging.h"
 #include "common/util/time.h"
 #include "services/perception/pipeline/image_decode.h"
@@ -135,11 +137,21 @@ void PerceptionPipeline::ProcessImage(const ImageFrame& frame) {
     result = processor_->ProcessFrame(frame);
   }
   result.receive_wall_utime = frame.receive_wall_utime;
+  CountTrackingTransition(result.camera_pose.tracking_state);
   sink_->OnFrameResult(result);
   ++frames_processed_;
   if (frame.receive_wall_utime > 0) {
     latency_.Add(UtimeToMs(WallUtime() - frame.receive_wall_utime));
   }
+}
+
+void PerceptionPipeline::CountTrackingTransition(TrackingState state) {
+  const bool tracked = state == TrackingState::kOk || state == TrackingState::kRelocalized;
+  if (tracked && !was_tracked_ && ever_tracked_) counters_->Increment(counter::kTrackingRecovered);
+  if (!tracked && was_tracked_) counters_->Increment(counter::kTrackingLost);
+  ever_tracked_ = ever_tracked_ || tracked;
+  was_tracked_ = tracked;
+  tracking_state_.store(static_cast<int>(state));
 }
 
 void PerceptionPipeline::ProcessLoop() {
@@ -148,7 +160,8 @@ void PerceptionPipeline::ProcessLoop() {
   // not extrapolated — the same decision on every replay, since it depends only on the
   // order of the log.
   std::optional<ImageFrame> pending;
-  int64_t last_odometry_utime = 0;
+  bool odometry_in_log = false;
+  int64_t last_odometry_utime = std::numeric_limits<int64_t>::min();
   while (true) {
     std::optional<FrameEvent> event =
         options_.lockstep() ? frame_queue_.Pop() : frame_queue_.PopFor(20000);
@@ -159,6 +172,7 @@ void PerceptionPipeline::ProcessLoop() {
     }
     if (auto* odom = std::get_if<OdometrySample>(&*event)) {
       processor_->OnOdometry(*odom);
+      odometry_in_log = true;
       last_odometry_utime = std::max(last_odometry_utime, odom->utime);
       if (pending && last_odometry_utime >= pending->utime) {
         ProcessImage(*pending);
@@ -171,7 +185,15 @@ void PerceptionPipeline::ProcessLoop() {
       ProcessImage(*pending);
       pending.reset();
     }
-    if (options_.lockstep() && last_odometry_utime > 0 && last_odometry_utime < frame.utime) {
+    // A new timeline (time went back for good): its first image goes through at once,
+    // so that the processor starts over before the new timeline's odometry reaches it;
+    // the old timeline's odometry covers none of the images after it.
+    if (frame.timeline_reset) {
+      ProcessImage(frame);
+      last_odometry_utime = std::numeric_limits<int64_t>::min();
+      continue;
+    }
+    if (options_.lockstep() && odometry_in_log && last_odometry_utime < frame.utime) {
       pending = std::move(frame);
       continue;
     }
@@ -245,10 +267,16 @@ PipelineStatus PerceptionPipeline::BuildStatus(int64_t wall_utime) {
       for (const auto& [pname, pvalue] : previous_counters_) {
         if (pname == name) before = pvalue;
       }
-      if (value > before) moved += (moved.empty() ? "" : ", ") + name + " +" + std::to_string(value - before);
+      if (value > before && !IsInformationalCounter(name)) {
+        moved += (moved.empty() ? "" : ", ") + name + " +" + std::to_string(value - before);
+      }
     }
     s.state = moved.empty() ? ServiceState::kRunning : ServiceState::kDegraded;
     s.message = moved.empty() ? "running" : moved;
+    const auto tracking = static_cast<TrackingState>(tracking_state_.load());
+    if (s.frames_processed > 0 && tracking != TrackingState::kOk && tracking != TrackingState::kRelocalized) {
+      s.message += std::string("; tracking ") + TrackingStateName(tracking);
+    }
   }
   previous_counters_ = s.counters;
   return s;

@@ -101,6 +101,8 @@ class PerceptionPipeline {
   void ProcessLoop();
   void DrainOdometry();
   void ProcessImage(const ImageFrame& frame);
+  // Counts the camera tracking state leaving / regaining OK (processing thread).
+  void CountTrackingTransition(TrackingState state);
 
   const PipelineOptions options_;
   FrameProcessor* processor_;
@@ -125,6 +127,9 @@ class PerceptionPipeline {
   std::atomic<int64_t> frames_rejected_{0};
   std::atomic<int64_t> latest_utime_{0};
   std::atomic<int64_t> last_image_wall_utime_{0};
+  std::atomic<int> tracking_state_{static_cast<int>(TrackingState::kNotInitialized)};
+  bool was_tracked_ = false;   // processing thread only
+  bool ever_tracked_ = false;  // processing thread only
 
   // Period bookkeeping for rates (BuildStatus caller's thread only).
   int64_t period_start_wall_ = 0;

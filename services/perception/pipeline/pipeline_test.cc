@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <mutex>
 #include <thread>
@@ -159,6 +160,87 @@ TEST(Pipeline, StatusReportsStagesQueuesAndDegradation) {
   bool counted = false;
   for (const auto& [n, v] : s.counters) counted |= n == counter::kImageTimeBackwards && v == 1;
   EXPECT_TRUE(counted);
+}
+
+TEST(Pipeline, LockstepNewTimelineStartsOverThenWaitsForItsOwnOdometry) {
+  PipelineOptions options;
+  options.mode = "lockstep";
+  RecordingProcessor processor;
+  CountingSink sink;
+  Counters counters;
+  StageTimers timers;
+  PerceptionPipeline pipeline(options, &processor, &sink, &counters, &timers);
+  pipeline.Start();
+  pipeline.Push(Odom(50));
+  pipeline.Push(Image(100));
+  pipeline.Push(Odom(150));
+  pipeline.Push(Image(200));
+  pipeline.Push(Odom(250));
+  RawImage reset = Image(10);  // time went back for good
+  reset.timeline_reset = true;
+  pipeline.Push(reset);
+  pipeline.Push(Odom(20));
+  pipeline.Push(Image(30));
+  pipeline.Push(Odom(40));
+  pipeline.Stop();
+  // The first image of the new timeline goes first (the processor starts over before
+  // the new odometry arrives); the old timeline's odometry (up to 250) must not let the
+  // next images through before their own.
+  const std::vector<std::string> expected = {"o50", "o150", "i100", "o250", "i200",
+                                             "i10", "o20",  "o40",  "i30"};
+  EXPECT_EQ(processor.events, expected);
+}
+
+// Returns the tracking states of a script, one per frame.
+class ScriptedProcessor : public FrameProcessor {
+ public:
+  explicit ScriptedProcessor(std::vector<TrackingState> script) : script_(std::move(script)) {}
+  void OnOdometry(const OdometrySample&) override {}
+  FrameResult ProcessFrame(const ImageFrame& f) override {
+    FrameResult r;
+    r.utime = f.utime;
+    r.camera_pose.tracking_state = script_[std::min(next_++, script_.size() - 1)];
+    return r;
+  }
+  void Finish() override {}
+
+ private:
+  std::vector<TrackingState> script_;
+  size_t next_ = 0;
+};
+
+TEST(Pipeline, TrackingLossAndRecoveryAreCountedAndReported) {
+  PipelineOptions options;
+  options.mode = "lockstep";
+  using T = TrackingState;
+  ScriptedProcessor processor({T::kNotInitialized, T::kInitializing, T::kOk, T::kOk, T::kLost, T::kLost,
+                               T::kNotInitialized, T::kInitializing, T::kRelocalized, T::kOk, T::kLost});
+  CountingSink sink;
+  Counters counters;
+  StageTimers timers;
+  PerceptionPipeline pipeline(options, &processor, &sink, &counters, &timers);
+  pipeline.Start();
+  for (int i = 1; i <= 10; ++i) pipeline.Push(Image(i * 100));
+  // Let the ten frames through before building a status mid-run.
+  for (int i = 0; i < 500 && pipeline.frames_processed() < 10; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_EQ(pipeline.frames_processed(), 10);
+  // The first initialisation is not a recovery; the way back after the loss is.
+  EXPECT_EQ(counters.Get(counter::kTrackingLost), 1);
+  EXPECT_EQ(counters.Get(counter::kTrackingRecovered), 1);
+  const PipelineStatus ok = pipeline.BuildStatus(1);
+  EXPECT_EQ(ok.message.find("; tracking "), std::string::npos) << ok.message;
+  pipeline.Push(Image(1100));
+  for (int i = 0; i < 500 && pipeline.frames_processed() < 11; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_EQ(counters.Get(counter::kTrackingLost), 2);
+  const PipelineStatus lost = pipeline.BuildStatus(2);
+  EXPECT_EQ(lost.state, ServiceState::kDegraded);
+  EXPECT_NE(lost.message.find("tracking_lost +1"), std::string::npos) << lost.message;
+  EXPECT_NE(lost.message.find("tracking lost"), std::string::npos) << lost.message;
+  pipeline.Stop();
 }
 
 }  // namespace

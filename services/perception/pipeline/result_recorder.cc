@@ -26,18 +26,31 @@ void ResultRecorder::OnFrameResult(const FrameResult& r) {
   ++frames_;
   if (r.world_rescaled_by) {
     // Keep the whole trajectory in one unit.
-    for (CameraPoseOutput& p : camera_) p.world_from_cam.translation *= *r.world_rescaled_by;
+    for (TimedPose& p : camera_) p.pose.translation *= *r.world_rescaled_by;
     for (auto& [id, poses] : objects_) {
-      for (auto& [utime, pose] : poses) pose.translation *= *r.world_rescaled_by;
+      for (TimedPose& p : poses) p.pose.translation *= *r.world_rescaled_by;
     }
   }
   const TrackingState s = r.camera_pose.tracking_state;
   if (s == TrackingState::kOk || s == TrackingState::kRelocalized) {
     ++tracked_;
-    camera_.push_back(r.camera_pose);
+    camera_.push_back(TimedPose{r.camera_pose.utime, r.camera_pose.world_from_cam});
+    while (camera_.size() > max_poses_) {
+      camera_.pop_front();
+      ++camera_poses_dropped_;
+    }
   }
   for (const ObjectOutput& o : r.objects) {
-    if (o.state != ObjectState::kDetected) objects_[o.id].emplace_back(r.utime, o.world_from_object);
+    if (o.state == ObjectState::kDetected) continue;
+    objects_[o.id].push_back(TimedPose{r.utime, o.world_from_object});
+    ++object_poses_;
+  }
+  // Over the budget: the oldest objects' trajectories go first, whole.
+  while (object_poses_ > max_poses_ && objects_.size() > 1) {
+    const size_t n = objects_.begin()->second.size();
+    object_poses_ -= n;
+    object_poses_dropped_ += static_cast<int64_t>(n);
+    objects_.erase(objects_.begin());
   }
   if (r.map) map_ = r.map;
   if (r.occupancy) occupancy_ = r.occupancy;
@@ -52,16 +65,19 @@ Status ResultRecorder::Write(const std::string& dir, const std::string& extra_su
   std::lock_guard<std::mutex> lock(mutex_);
   ::mkdir(dir.c_str(), 0755);
   ::mkdir((dir + "/objects").c_str(), 0755);
+  // A process killed during an earlier save leaves its temporary files behind.
+  RemoveStaleTempFiles(dir);
+  RemoveStaleTempFiles(dir + "/objects");
   {
     std::ostringstream out;
     out << "# world_from_cam, TUM format: t tx ty tz qx qy qz qw\n";
-    for (const CameraPoseOutput& p : camera_) out << TumLine(p.utime, p.world_from_cam) << "\n";
+    for (const TimedPose& p : camera_) out << TumLine(p.utime, p.pose) << "\n";
     MBSLAM_RETURN_IF_ERROR(WriteStringAtomically(dir + "/camera_trajectory.tum", out.str()));
   }
   for (const auto& [id, poses] : objects_) {
     std::ostringstream out;
     out << "# world_from_object " << id << ", TUM format\n";
-    for (const auto& [utime, pose] : poses) out << TumLine(utime, pose) << "\n";
+    for (const TimedPose& p : poses) out << TumLine(p.utime, p.pose) << "\n";
     MBSLAM_RETURN_IF_ERROR(
         WriteStringAtomically(dir + "/objects/" + std::to_string(id) + ".tum", out.str()));
   }
@@ -88,7 +104,9 @@ Status ResultRecorder::Write(const std::string& dir, const std::string& extra_su
        << ",\n  \"first_utime\": " << first_utime_ << ",\n  \"last_utime\": " << last_utime_
        << ",\n  \"objects_with_trajectory\": " << objects_.size()
        << ",\n  \"map_points\": " << (map_ ? map_->points.size() : 0)
-       << ",\n  \"occupied_voxels\": " << (occupancy_ ? occupancy_->num_occupied : 0);
+       << ",\n  \"occupied_voxels\": " << (occupancy_ ? occupancy_->num_occupied : 0)
+       << ",\n  \"camera_poses_dropped\": " << camera_poses_dropped_
+       << ",\n  \"object_poses_dropped\": " << object_poses_dropped_;
   if (!extra_summary.empty()) json << ",\n  " << extra_summary;
   json << "\n}\n";
   return WriteStringAtomically(dir + "/summary.json", json.str());

@@ -5,6 +5,7 @@
 // and occupancy, run statistics) and writes them atomically on request or exit:
 //   camera_trajectory.tum, objects/<id>.tum, map.ply, occupancy.bt, summary.json
 
+#include <deque>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -18,6 +19,12 @@ namespace mbslam {
 
 class ResultRecorder : public OutputSink {
  public:
+  // Trajectories keep at most `max_poses` poses each for the camera and, in total, for
+  // the objects (64 bytes a pose); beyond that the oldest go (counted in summary.json),
+  // so a service running for days does not grow without bound.
+  static constexpr size_t kDefaultMaxPoses = size_t{1} << 20;  // ~9.7 h at 30 Hz, 64 MB
+  explicit ResultRecorder(size_t max_poses = kDefaultMaxPoses) : max_poses_(max_poses) {}
+
   void OnFrameResult(const FrameResult& result) override;
 
   // Writes every output file into `dir` (created if missing). `extra_summary` is a
@@ -27,9 +34,18 @@ class ResultRecorder : public OutputSink {
   int64_t frames() const;
 
  private:
+  struct TimedPose {
+    int64_t utime = 0;  // µs
+    Rigid3d pose;       // world_from_cam / world_from_object
+  };
+
+  const size_t max_poses_;
   mutable std::mutex mutex_;
-  std::vector<CameraPoseOutput> camera_;  // tracked frames only
-  std::map<int, std::vector<std::pair<int64_t, Rigid3d>>> objects_;
+  std::deque<TimedPose> camera_;  // tracked frames only, oldest first
+  std::map<int, std::vector<TimedPose>> objects_;  // ids grow with time: begin() is the oldest
+  size_t object_poses_ = 0;
+  int64_t camera_poses_dropped_ = 0;
+  int64_t object_poses_dropped_ = 0;
   std::optional<MapOutput> map_;
   std::optional<OccupancyOutput> occupancy_;
   int64_t frames_ = 0;

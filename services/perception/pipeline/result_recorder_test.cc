@@ -37,5 +37,37 @@ TEST(ResultRecorder, WritesTrackedPosesAndSummary) {
   EXPECT_NE(summary.find("\"note\": 1"), std::string::npos);
 }
 
+TEST(ResultRecorder, TrajectoriesAreBoundedOldestDropped) {
+  ResultRecorder recorder(/*max_poses=*/10);
+  for (int i = 0; i < 25; ++i) {
+    FrameResult r;
+    r.utime = 1000000 + i * 100000;
+    r.camera_pose.utime = r.utime;
+    r.camera_pose.tracking_state = TrackingState::kOk;
+    r.camera_pose.world_from_cam.translation.x() = i;
+    ObjectOutput o;
+    o.id = 1 + i / 5;  // five poses per object
+    o.state = ObjectState::kTracked;
+    r.objects.push_back(o);
+    recorder.OnFrameResult(r);
+  }
+  char pattern[] = "/tmp/mbslam_rec_XXXXXX";
+  const std::string dir = mkdtemp(pattern);
+  ASSERT_TRUE(recorder.Write(dir, "").ok());
+  std::string traj, summary, first_object;
+  ASSERT_TRUE(ReadFileToString(dir + "/camera_trajectory.tum", &traj).ok());
+  ASSERT_TRUE(ReadFileToString(dir + "/summary.json", &summary).ok());
+  int lines = 0;
+  for (char c : traj) lines += c == '\n';
+  EXPECT_EQ(lines, 11);  // header + the newest 10
+  EXPECT_NE(traj.find("\n2.500000 15.0"), std::string::npos) << traj;  // the oldest kept
+  EXPECT_NE(summary.find("\"camera_poses_dropped\": 15"), std::string::npos) << summary;
+  // Objects 1-3 (15 poses) dropped whole to get back to 10.
+  EXPECT_NE(summary.find("\"object_poses_dropped\": 15"), std::string::npos) << summary;
+  EXPECT_FALSE(ReadFileToString(dir + "/objects/3.tum", &first_object).ok());
+  EXPECT_TRUE(ReadFileToString(dir + "/objects/4.tum", &first_object).ok());
+  EXPECT_NE(summary.find("\"frames\": 25"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace mbslam
