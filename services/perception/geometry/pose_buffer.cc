@@ -1,8 +1,18 @@
 #include "services/perception/geometry/pose_buffer.h"
 
 #include <algorithm>
+#include <cstdint>
 
 namespace mbslam {
+namespace {
+
+// later - earlier for later >= earlier, exact over the whole int64 range (the signed
+// difference overflowed for sample times read from files, e.g. -9e18 and 9e18 µs).
+uint64_t Span(int64_t earlier, int64_t later) {
+  return static_cast<uint64_t>(later) - static_cast<uint64_t>(earlier);
+}
+
+}  // namespace
 
 const char* InterpolationResultName(InterpolationResult result) {
   switch (result) {
@@ -39,8 +49,11 @@ InterpolationResult PoseBuffer::Interpolate(int64_t utime, Rigid3d* pose) const 
   }
   const StampedPose& b = *upper;
   const StampedPose& a = *(upper - 1);
-  if (b.utime - a.utime > max_gap_us_) return InterpolationResult::kGapTooLarge;
-  const double t = static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime);
+  const uint64_t span = Span(a.utime, b.utime);
+  if (max_gap_us_ < 0 || span > static_cast<uint64_t>(max_gap_us_)) {
+    return InterpolationResult::kGapTooLarge;
+  }
+  const double t = static_cast<double>(Span(a.utime, utime)) / static_cast<double>(span);
   *pose = Rigid3d::Interpolate(a.pose, b.pose, t);
   return InterpolationResult::kOk;
 }
@@ -49,7 +62,7 @@ bool PoseBuffer::Extrapolate(int64_t utime, Rigid3d* pose) const {
   if (samples_.size() < 2 || utime < samples_.back().utime) return false;
   const StampedPose& b = samples_.back();
   const StampedPose& a = samples_[samples_.size() - 2];
-  const double t = static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime);
+  const double t = static_cast<double>(Span(a.utime, utime)) / static_cast<double>(Span(a.utime, b.utime));
   *pose = Rigid3d::Interpolate(a.pose, b.pose, t);  // t > 1 continues the geodesic
   return true;
 }

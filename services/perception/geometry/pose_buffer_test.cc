@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace mbslam {
 namespace {
 
@@ -67,6 +69,28 @@ TEST(PoseBuffer, RejectsTimeGoingBackAndNonFinite) {
   buffer.Insert(4000, Rigid3d());
   buffer.PruneBefore(3500);
   EXPECT_EQ(buffer.first_utime(), 3000);
+}
+
+// Regression (issue 9, a TUM groundtruth.txt with times -9e12 s and 9e12 s): the gap
+// b.utime - a.utime overflowed int64 (UBSan: signed integer overflow). The span between
+// two samples is now exact over the whole int64 range.
+TEST(PoseBuffer, SamplesAtTheEndsOfTheTimeRange) {
+  const int64_t max = std::numeric_limits<int64_t>::max();
+  const Rigid3d moved(Eigen::Quaterniond::Identity(), Eigen::Vector3d(2, 0, 0));
+  Rigid3d pose;
+  // 1.8e19 us apart: more than any int64 gap bound.
+  PoseBuffer wide(/*max_gap_us=*/max);
+  ASSERT_TRUE(wide.Insert(-9000000000000000000, Rigid3d()).ok());
+  ASSERT_TRUE(wide.Insert(9000000000000000000, moved).ok());
+  EXPECT_EQ(wide.Interpolate(0, &pose), InterpolationResult::kGapTooLarge);
+  ASSERT_TRUE(wide.Extrapolate(9000000000000000000, &pose));
+  EXPECT_NEAR(pose.translation.x(), 2.0, 1e-9);
+  // 8e18 us apart, within the bound: interpolated.
+  PoseBuffer half(/*max_gap_us=*/max);
+  ASSERT_TRUE(half.Insert(-4000000000000000000, Rigid3d()).ok());
+  ASSERT_TRUE(half.Insert(4000000000000000000, moved).ok());
+  ASSERT_EQ(half.Interpolate(0, &pose), InterpolationResult::kOk);
+  EXPECT_NEAR(pose.translation.x(), 1.0, 1e-9);
 }
 
 }  // namespace

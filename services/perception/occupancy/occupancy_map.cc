@@ -105,6 +105,22 @@ OccupancyInsertSummary OccupancyMap::InsertRays(
   return summary;
 }
 
+namespace {
+
+// OctoMap's coordToKeyChecked converts resolution_factor * coordinate to int before it
+// checks the range, which is undefined behaviour for points far outside the tree (UBSan:
+// "1e+10 is outside the range of representable values of type 'int'"). Coordinates
+// outside the tree's 2^15 voxels per side, and NaN, are refused here first.
+bool KeyInTree(const octomap::OcTree& tree, const octomap::point3d& p, octomap::OcTreeKey& key) {
+  const double limit = tree.getResolution() * 32768.0;
+  for (int i = 0; i < 3; ++i) {
+    if (!(std::abs(static_cast<double>(p(i))) < limit)) return false;
+  }
+  return tree.coordToKeyChecked(p, key);
+}
+
+}  // namespace
+
 void OccupancyMap::InsertBatch(const RayBatch& batch, OccupancyInsertSummary* summary) {
   // OctoMap's insertPointCloud (computeUpdate / computeDiscreteUpdate, then one update
   // per voxel, occupied before free), with the update step done in one depth-first walk
@@ -112,7 +128,7 @@ void OccupancyMap::InsertBatch(const RayBatch& batch, OccupancyInsertSummary* su
   // letting OctoMap print a warning per ray.
   const octomap::point3d origin = ToOcto(batch.origin);
   octomap::OcTreeKey key;
-  if (!tree_->coordToKeyChecked(origin, key)) {
+  if (!KeyInTree(*tree_, origin, key)) {
     summary->rays_rejected += static_cast<int>(batch.ends.size());
     return;
   }
@@ -123,7 +139,7 @@ void OccupancyMap::InsertBatch(const RayBatch& batch, OccupancyInsertSummary* su
     const octomap::point3d p(e.x(), e.y(), e.z());
     // Discretised: one ray per end voxel, to its centre (points outside the tree's
     // range go on as they are and are rejected below).
-    if (options_.discretize && tree_->coordToKeyChecked(p, key)) {
+    if (options_.discretize && KeyInTree(*tree_, p, key)) {
       if (end_voxels.insert(key).second) {
         ends.push_back(tree_->keyToCoord(key));
       } else {
@@ -140,7 +156,7 @@ void OccupancyMap::InsertBatch(const RayBatch& batch, OccupancyInsertSummary* su
   for (const octomap::point3d& p : ends) {
     if (max_range_ < 0.0 || (p - origin).norm() <= max_range_) {
       octomap::OcTreeKey end_key;
-      if (!tree_->coordToKeyChecked(p, end_key)) {
+      if (!KeyInTree(*tree_, p, end_key)) {
         ++summary->rays_rejected;
         continue;
       }
@@ -153,7 +169,7 @@ void OccupancyMap::InsertBatch(const RayBatch& batch, OccupancyInsertSummary* su
     } else {
       const octomap::point3d direction = (p - origin).normalized();
       const octomap::point3d last = origin + direction * static_cast<float>(max_range_);
-      if (!tree_->coordToKeyChecked(last, key)) {
+      if (!KeyInTree(*tree_, last, key)) {
         ++summary->rays_rejected;
         continue;
       }
@@ -265,7 +281,7 @@ std::optional<double> OccupancyMap::Occupancy(const Eigen::Vector3d& point_in_wo
     return std::nullopt;
   }
   octomap::OcTreeKey key;
-  if (!tree_->coordToKeyChecked(ToOcto(point_in_world), key)) {
+  if (!KeyInTree(*tree_, ToOcto(point_in_world), key)) {
     return std::nullopt;
   }
   const octomap::OcTreeNode* node = tree_->search(key);
@@ -280,7 +296,7 @@ bool OccupancyMap::IsOccupied(const Eigen::Vector3d& point_in_world) const {
     return false;
   }
   octomap::OcTreeKey key;
-  if (!tree_->coordToKeyChecked(ToOcto(point_in_world), key)) {
+  if (!KeyInTree(*tree_, ToOcto(point_in_world), key)) {
     return false;
   }
   const octomap::OcTreeNode* node = tree_->search(key);
