@@ -261,9 +261,12 @@ void RenderImageView(const ImageViewOptions& options, const ImageViewInput& inpu
         } else {
           std::snprintf(text, sizeof(text), "#%d", hull.body_id);
         }
-        const int x = std::clamp(static_cast<int>(left.x()), 2, std::max(2, out_size.width - 160));
-        const int y =
-            std::clamp(static_cast<int>(top.y()) - 6, 14, std::max(14, out_size.height - 4));
+        // Clamped as doubles: hull vertices come from the message, and casting 1e30 to
+        // int was undefined (found by fuzz_viewer_lcm under UBSan).
+        const int x = static_cast<int>(
+            std::clamp(left.x(), 2.0, static_cast<double>(std::max(2, out_size.width - 160))));
+        const int y = static_cast<int>(std::clamp(std::trunc(top.y()) - 6.0, 14.0,
+                                                  static_cast<double>(std::max(14, out_size.height - 4))));
         DrawOutlinedText(bgr, text, cv::Point(x, y), font * 1.1, ObjectColor(hull.body_id), 1);
       }
     }

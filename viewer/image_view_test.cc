@@ -199,6 +199,19 @@ TEST_F(ImageViewTest, EnlargingNeverExceedsTheMaximumViewSize) {
   EXPECT_LE(out.rows, kMaxViewDimension + 600);
 }
 
+// Regression (fuzz_viewer_lcm, issue 9): a hull with finite but huge vertices put
+// its label at static_cast<int>(-1.7e30), undefined behaviour (UBSan).
+TEST_F(ImageViewTest, HullWithHugeVerticesIsLabelledInsideTheImage) {
+  ImageHull far;
+  far.body_id = 3;
+  far.points = {Eigen::Vector2f(-1.7e30f, 1e30f), Eigen::Vector2f(1e30f, -1e30f),
+                Eigen::Vector2f(0.f, 3e30f)};
+  tracks_.hulls.push_back(far);
+  options_.show_labels = true;
+  const cv::Mat out = Render();
+  EXPECT_EQ(out.size(), image_.size());
+}
+
 TEST_F(ImageViewTest, LegendBandsAndScalingMoveTheImage) {
   options_.show_legend = true;
   options_.scale = 2.0;

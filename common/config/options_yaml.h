@@ -71,7 +71,13 @@ class YamlReader {
   Status Finish() const {
     if (!status_.ok()) return status_;
     for (const auto& kv : node_) {
-      const std::string key = kv.first.as<std::string>();
+      // A key that is a list or a mapping ("? [a, b]: 1"): as<std::string>() threw
+      // YAML::BadConversion out of the loader (found by fuzz_config_yaml).
+      if (!kv.first.IsScalar()) {
+        return Status::Error("option section '" + (path_.empty() ? std::string("<root>") : path_) +
+                             "' has a key that is not a name");
+      }
+      const std::string key = kv.first.Scalar();
       if (!known_.count(key)) {
         return Status::Error("unknown option '" + JoinPath(path_, key.c_str()) +
                              "' (known here: " + Sorted(known_) + ")");
@@ -145,7 +151,11 @@ Status CheckYamlTextIsUtf8(const std::string& text, const std::string& what);
 template <typename T>
 Status LoadOptionsFromYaml(const YAML::Node& node, const std::string& section, T* options) {
   T loaded = *options;
-  MBSLAM_RETURN_IF_ERROR(internal::YamlReader::ReadSection(node, section, &loaded));
+  try {
+    MBSLAM_RETURN_IF_ERROR(internal::YamlReader::ReadSection(node, section, &loaded));
+  } catch (const YAML::Exception& e) {  // the loader must never throw at its caller
+    return Status::Error("YAML: " + std::string(e.what()));
+  }
   if (!loaded.Check()) {
     return Status::Error((section.empty() ? std::string("options") : section) +
                          ": " + LastOptionError());

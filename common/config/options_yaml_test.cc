@@ -142,5 +142,17 @@ TEST(OptionsYaml, TextMustBeUtf8) {
             std::string::npos);
 }
 
+// Regression (fuzz_config_yaml, issue 9): a key that is a list or a mapping made the
+// loader throw YAML::BadConversion at its caller (perception_service --config).
+TEST(OptionsYaml, KeysThatAreNotNamesAreErrors) {
+  for (const std::string text : {"? [a, b]\n: 1\n", "{[x]: 1}\n", "inner:\n  ? {k: v}\n  : 2\n"}) {
+    OuterOptions o;
+    Status s;
+    ASSERT_NO_THROW(s = LoadOptionsFromYamlText(text, "", &o)) << text;
+    EXPECT_FALSE(s.ok()) << text;
+    EXPECT_NE(s.message().find("not a name"), std::string::npos) << s.message();
+  }
+}
+
 }  // namespace
 }  // namespace mbslam
