@@ -4,7 +4,12 @@ if(MBSLAM_WERROR)
   list(APPEND MBSLAM_WARNING_FLAGS -Werror)
 endif()
 
-if(MBSLAM_SANITIZE)
+if(MBSLAM_SANITIZE STREQUAL "address")
+  # AddressSanitizer alone (LeakSanitizer included), e.g. for long leak runs.
+  message(STATUS "mbslam: AddressSanitizer enabled")
+  add_compile_options(-fsanitize=address -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=address)
+elseif(MBSLAM_SANITIZE)
   message(STATUS "mbslam: AddressSanitizer + UBSan enabled")
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
