@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
+#include <limits>
+#include <set>
+#include <utility>
 
 #include <opencv2/video/tracking.hpp>
 
@@ -19,6 +23,8 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
       mapping_timer_(timers->Get("slam_mapping")),
       occupancy_timer_(timers->Get("occupancy")),
       objects_timer_(timers->Get("objects")),
+      person_timer_(timers->Get("person")),
+      outputs_timer_(timers->Get("outputs")),
       odometry_(options.preprocess.max_odometry_gap_us,
                 static_cast<size_t>(options.preprocess.max_odometry_samples)),
       tracker_(options.tracking),
@@ -42,6 +48,8 @@ void PerceptionCore::Reset() {
   odometry_.Clear();
   frame_utime_.clear();
   occluders_.clear();
+  if (person_job_.valid()) person_job_.wait();
+  person_job_ = {};
   person_checked_.clear();
   is_person_.clear();
 }
@@ -434,6 +442,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   }
   if (slam_.map().num_keyframes() > 0 &&
       (map_update.new_keyframe || frame_index_ - last_map_publish_frame_ >= options_.map_publish_every_frames)) {
+    ScopedStageTimer timer(outputs_timer_);
     result.map = BuildMapOutput(frame.utime);
     last_map_publish_frame_ = frame_index_;
   }
@@ -508,6 +517,34 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
                                                       : o.id;
   }
 
+  // Person checks run on the other core, one image behind: the checks launched with the
+  // previous image are collected here (waiting if they are not done, so that the result
+  // is the same in every mode), and this image's are launched after its hulls.
+  {
+    ScopedStageTimer timer(person_timer_);
+    CollectPersonChecks();
+  }
+  // Person checks due in this image: at most max_checks_per_frame, the least recently
+  // checked first (a burst of new objects would otherwise stall one image).
+  std::set<int> person_check_due;
+  std::vector<std::pair<int, cv::Rect>> person_boxes;
+  if (options_.person.enabled) {
+    std::vector<std::pair<int64_t, int>> due;  // (last check frame, object id)
+    for (const SegmentedObject& o : seg.objects) {
+      if (o.hull.size() < 3) continue;
+      const int oid = object_id_of[o.id];
+      auto last = person_checked_.find(oid);
+      const int64_t last_frame = last == person_checked_.end() ? std::numeric_limits<int64_t>::min() : last->second;
+      if (last == person_checked_.end() || frame_index_ - last_frame >= options_.person.every_n_frames) {
+        due.emplace_back(last_frame, oid);
+      }
+    }
+    std::sort(due.begin(), due.end());
+    for (size_t k = 0; k < due.size() && static_cast<int>(k) < options_.person.max_checks_per_frame; ++k) {
+      person_check_due.insert(due[k].second);
+    }
+  }
+
   // Moving objects: hulls, person check, occluders for the next image.
   occluders_.clear();
   for (const SegmentedObject& o : seg.objects) {
@@ -536,14 +573,10 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       max_x = std::max(max_x, static_cast<float>(p.x()));
       max_y = std::max(max_y, static_cast<float>(p.y()));
     }
-    if (options_.person.enabled && hull.points.size() >= 3) {
-      auto last = person_checked_.find(oid);
-      if (last == person_checked_.end() || frame_index_ - last->second >= options_.person.every_n_frames) {
-        const cv::Rect box(static_cast<int>(min_x), static_cast<int>(min_y),
-                           static_cast<int>(max_x - min_x), static_cast<int>(max_y - min_y));
-        if (person_detector_.Detect(frame.gray, box)) is_person_[oid] = true;
-        person_checked_[oid] = frame_index_;
-      }
+    if (person_check_due.count(oid) && hull.points.size() >= 3) {
+      person_boxes.emplace_back(oid, cv::Rect(static_cast<int>(min_x), static_cast<int>(min_y),
+                                              static_cast<int>(max_x - min_x), static_cast<int>(max_y - min_y)));
+      person_checked_[oid] = frame_index_;
     }
     out.object_class = is_person_[oid] ? ObjectClass::kPerson : ObjectClass::kUnknown;
     out.hull = hull;
@@ -561,6 +594,14 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     out.object_class = is_person_[id] ? ObjectClass::kPerson : ObjectClass::kUnknown;
     FillObjectEstimate(*t, &out);
     result.objects.push_back(std::move(out));
+  }
+  if (!person_boxes.empty()) {
+    // frame.gray is not written after decoding; the job holds a reference to it.
+    person_job_ = std::async(std::launch::async, [this, gray = frame.gray, boxes = std::move(person_boxes)] {
+      std::vector<std::pair<int, bool>> found;
+      for (const auto& [id, box] : boxes) found.emplace_back(id, person_detector_.Detect(gray, box));
+      return found;
+    });
   }
   result.epipole = seg.epipole;
 
@@ -588,6 +629,13 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     result.tracks.push_back(o);
   }
   return result;
+}
+
+void PerceptionCore::CollectPersonChecks() {
+  if (!person_job_.valid()) return;
+  for (const auto& [id, found] : person_job_.get()) {
+    if (found) is_person_[id] = true;
+  }
 }
 
 }  // namespace mbslam

@@ -7,8 +7,10 @@
 
 #include <array>
 #include <cmath>
+#include <future>
 #include <map>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -134,6 +136,7 @@ class PerceptionCore : public FrameProcessor {
   MapOutput BuildMapOutput(int64_t utime) const;
   void FillObjectEstimate(const TrackedObject& tracked, ObjectOutput* out) const;
   void Reset();
+  void CollectPersonChecks();  // results of the previous image's person checks into is_person_
 
   const CoreOptions options_;
   Counters* counters_;
@@ -144,6 +147,8 @@ class PerceptionCore : public FrameProcessor {
   TimingStats* mapping_timer_;
   TimingStats* occupancy_timer_;
   TimingStats* objects_timer_;
+  TimingStats* person_timer_;   // person checks (part of no other stage)
+  TimingStats* outputs_timer_;  // map / track messages built for the sinks
   PoseBuffer odometry_;
   Rigid3d base_from_cam_;
   FeatureTracker tracker_;
@@ -160,6 +165,8 @@ class PerceptionCore : public FrameProcessor {
   std::vector<TrackingHints::Hull> occluders_;  // moving objects' hulls predicted for the next image
   std::map<int, int64_t> person_checked_;    // object id -> frame of the last person check
   std::map<int, bool> is_person_;
+  // Person checks of the previous image, running on another thread (object id, found).
+  std::future<std::vector<std::pair<int, bool>>> person_job_;
   std::map<int, int64_t> object_first_utime_;
   int64_t frame_index_ = -1;
 };

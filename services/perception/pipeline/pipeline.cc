@@ -44,6 +44,7 @@ PerceptionPipeline::PerceptionPipeline(const PipelineOptions& options, FrameProc
       counters_(counters),
       timers_(timers),
       decode_timer_(timers->Get("decode")),
+      publish_timer_(timers->Get("publish")),
       frame_timer_(timers->Get("frame_total", options.frame_budget_ms)),
       latency_("latency"),
       input_queue_(options.lockstep() ? options.lockstep_queue_capacity : options.image_queue_capacity,
@@ -138,7 +139,10 @@ void PerceptionPipeline::ProcessImage(const ImageFrame& frame) {
   }
   result.receive_wall_utime = frame.receive_wall_utime;
   CountTrackingTransition(result.camera_pose.tracking_state);
-  sink_->OnFrameResult(result);
+  {
+    ScopedStageTimer timer(publish_timer_);
+    sink_->OnFrameResult(result);
+  }
   ++frames_processed_;
   if (frame.receive_wall_utime > 0) {
     latency_.Add(UtimeToMs(WallUtime() - frame.receive_wall_utime));

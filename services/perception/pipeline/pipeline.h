@@ -110,6 +110,7 @@ class PerceptionPipeline {
   Counters* counters_;
   StageTimers* timers_;
   TimingStats* decode_timer_;
+  TimingStats* publish_timer_;  // the sink (encoding, publishing, recording) per image
   TimingStats* frame_timer_;
   TimingStats latency_;
 

@@ -1,6 +1,7 @@
 #include "services/perception/segmentation/person_detector.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <opencv2/imgproc.hpp>
 
@@ -11,25 +12,36 @@ PersonDetector::PersonDetector(const PersonDetectorOptions& options) : options_(
 }
 
 bool PersonDetector::Detect(const cv::Mat& gray, const cv::Rect& box) const {
-  if (box.height < options_.min_box_height_px) return false;
-  const int px = static_cast<int>(box.width * options_.padding);
-  const int py = static_cast<int>(box.height * options_.padding);
-  cv::Rect roi(box.x - px, box.y - py, box.width + 2 * px, box.height + 2 * py);
+  if (box.height < options_.min_box_height_px || box.width <= 0) return false;
+  // The default detector window is 64x128 px with a person of ~96 px in it. The region
+  // searched is the box grown by `padding`, and at least one window's shape around a
+  // person of the box's height (a moving person's hull is narrower than the window).
+  constexpr double kPersonInWindowPx = 96.0;
+  const double want_w = std::max(box.width * (1.0 + 2.0 * options_.padding), box.height * (64.0 / kPersonInWindowPx) * 1.25);
+  const double want_h = std::max(box.height * (1.0 + 2.0 * options_.padding), box.height * (128.0 / kPersonInWindowPx) * 1.15);
+  const double cx = box.x + 0.5 * box.width, cy = box.y + 0.5 * box.height;
+  cv::Rect roi(static_cast<int>(std::floor(cx - 0.5 * want_w)), static_cast<int>(std::floor(cy - 0.5 * want_h)),
+               static_cast<int>(std::ceil(want_w)), static_cast<int>(std::ceil(want_h)));
   roi &= cv::Rect(0, 0, gray.cols, gray.rows);
-  if (roi.width < 64 || roi.height < 128) {
-    // The default detector window is 64x128: upscale small regions to it.
-    if (roi.width <= 0 || roi.height <= 0) return false;
-  }
+  if (roi.width <= 0 || roi.height <= 0) return false;
   cv::Mat patch = gray(roi);
+  // Scale: a small person up to the window's person height (HOG only searches larger
+  // scales), a large one down to max_box_height_px (bounds the cost), and the region to
+  // at least one window.
   double scale = 1.0;
-  if (patch.cols < 64 || patch.rows < 128) {
-    scale = std::max(64.0 / patch.cols, 128.0 / patch.rows);
-    cv::resize(patch, patch, cv::Size(), scale, scale, cv::INTER_LINEAR);
+  if (box.height < kPersonInWindowPx) {
+    scale = kPersonInWindowPx / box.height;
+  } else if (box.height > options_.max_box_height_px) {
+    scale = static_cast<double>(options_.max_box_height_px) / box.height;
+  }
+  scale = std::max(scale, std::max(64.0 / patch.cols, 128.0 / patch.rows));
+  if (scale != 1.0) {
+    cv::resize(patch, patch, cv::Size(), scale, scale, scale > 1.0 ? cv::INTER_LINEAR : cv::INTER_AREA);
   }
   std::vector<cv::Rect> found;
   std::vector<double> weights;
   hog_.detectMultiScale(patch, found, weights, options_.hit_threshold, cv::Size(8, 8), cv::Size(0, 0),
-                        1.05, 2.0);
+                        options_.scale_step, 2.0);
   for (const cv::Rect& f : found) {
     const cv::Rect in_image(static_cast<int>(f.x / scale) + roi.x, static_cast<int>(f.y / scale) + roi.y,
                             static_cast<int>(f.width / scale), static_cast<int>(f.height / scale));

@@ -3,7 +3,9 @@
 
 // Person detection restricted to moving regions (thesis sec. 3.9.4): OpenCV's HOG
 // people detector runs only inside the (padded) bounding box of a moving object, so
-// its cost follows the moving area, not the image.
+// its cost follows the moving area, not the image. A large region is scaled down first
+// (a person filling it stays well above the 64x128 detector window), so the cost of one
+// check is bounded whatever the object's size.
 
 #include <opencv2/core/mat.hpp>
 #include <opencv2/objdetect.hpp>
@@ -15,16 +17,22 @@ namespace mbslam {
 struct PersonDetectorOptions {
   bool enabled = true;             // run the detector on moving objects
   int every_n_frames = 5;          // per object, at most once per this many images (frames)
-  double padding = 0.25;           // box grown by this fraction on each side
+  double padding = 0.25;           // box grown by this fraction on each side (and to one detector window at least)
   double hit_threshold = 0.3;      // SVM margin of a detection
   double min_overlap = 0.3;        // detection area inside the object's box / detection area
   int min_box_height_px = 48;      // smaller moving regions are not tried (px)
+  int max_box_height_px = 192;     // larger regions are scaled down to this height first (px; bounds the cost)
+  double scale_step = 1.05;        // HOG pyramid step between detection scales
+  int max_checks_per_frame = 1;    // objects checked per image at most, least recently checked first (count)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(every_n_frames, 1);
     MBSLAM_CHECK_OPTION_GE(padding, 0.0);
     MBSLAM_CHECK_OPTION(min_overlap >= 0.0 && min_overlap <= 1.0);
     MBSLAM_CHECK_OPTION_GT(min_box_height_px, 0);
+    MBSLAM_CHECK_OPTION_GE(max_box_height_px, 128);
+    MBSLAM_CHECK_OPTION(scale_step > 1.0 && scale_step <= 2.0);
+    MBSLAM_CHECK_OPTION_GE(max_checks_per_frame, 1);
     return true;
   }
   template <typename V>
@@ -35,6 +43,9 @@ struct PersonDetectorOptions {
     v("hit_threshold", &hit_threshold, "HOG SVM margin of a detection");
     v("min_overlap", &min_overlap, "fraction of a detection inside the object's box");
     v("min_box_height_px", &min_box_height_px, "smaller regions are not tried (px)");
+    v("max_box_height_px", &max_box_height_px, "larger regions are scaled down to this height first (px)");
+    v("scale_step", &scale_step, "HOG pyramid step between detection scales");
+    v("max_checks_per_frame", &max_checks_per_frame, "objects checked per image at most, least recently checked first");
   }
 };
 

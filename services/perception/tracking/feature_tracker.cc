@@ -120,8 +120,11 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
       }
     }
     back_pts = prev_pts;
+    // The backward pass starts where the track came from; with fewer levels it is faster
+    // but lets more false matches through (7.5 % of tracks on an unrelated image with 3
+    // levels, 10 % with 2, 11.6 % with 1: feature_tracker_test).
     cv::calcOpticalFlowPyrLK(pyramid, prev_pyramid_, next_pts, back_pts, back_status, err, win,
-                             max_level, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+                             options_.klt_backward_levels - 1, term, cv::OPTFLOW_USE_INITIAL_FLOW);
   }
 
   const float fb2 = static_cast<float>(options_.max_forward_backward_px *

@@ -121,7 +121,7 @@ TEST(FeatureTracker, InconsistentMatchesAreDropped) {
   tracker.TrackFrame(Pyramid(Texture(320, 240, 99)), 1, {});
   int survivors = 0;
   for (const Track& t : tracker.tracks()) survivors += !t.is_new;
-  EXPECT_LT(survivors, static_cast<int>(before / 10));
+  EXPECT_LT(survivors, static_cast<int>(before / 10)) << "of " << before;
 }
 
 TEST(FeatureTracker, GuidedMatchRecoversLostTracksNearPrediction) {
