@@ -53,6 +53,7 @@ struct PerceptionOptions {
   OccupancyMapOptions occupancy;
   bool occupancy_enabled = true;
   int64_t occupancy_publish_period_us = 1000000;
+  int map_publish_every_frames = 15;
   ObjectTrackingOptions objects;
 
   CoreOptions core() const {
@@ -67,6 +68,7 @@ struct PerceptionOptions {
     c.occupancy = occupancy;
     c.occupancy_enabled = occupancy_enabled;
     c.occupancy_publish_period_us = occupancy_publish_period_us;
+    c.map_publish_every_frames = map_publish_every_frames;
     c.objects = objects;
     // Lockstep replays must be deterministic: bundle adjustment runs inline there.
     if (pipeline.lockstep()) c.slam.background_ba = false;
@@ -88,6 +90,7 @@ struct PerceptionOptions {
     MBSLAM_CHECK_OPTION_SECTION(occupancy);
     MBSLAM_CHECK_OPTION_SECTION(objects);
     MBSLAM_CHECK_OPTION_GE(occupancy_publish_period_us, 0);
+    MBSLAM_CHECK_OPTION_GE(map_publish_every_frames, 1);
     return true;
   }
   template <typename V>
@@ -107,6 +110,8 @@ struct PerceptionOptions {
     v("occupancy_publish_period_us", &occupancy_publish_period_us,
       "PERCEPTION_OCCUPANCY at most this often, at keyframes (us)");
     v("occupancy", &occupancy, "OctoMap occupancy of the static world (sec. 6.3)");
+    v("map_publish_every_frames", &map_publish_every_frames,
+      "PERCEPTION_MAP at least this often (frames), and at every keyframe");
     v("objects", &objects, "bearing-only tracking of moving objects, extent, predicted volumes (ch. 5-6)");
   }
 };

@@ -24,6 +24,7 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
       occupancy_timer_(timers->Get("occupancy")),
       objects_timer_(timers->Get("objects")),
       person_timer_(timers->Get("person")),
+      ba_timer_(timers->Get("local_ba")),
       outputs_timer_(timers->Get("outputs")),
       odometry_(options.preprocess.max_odometry_gap_us,
                 static_cast<size_t>(options.preprocess.max_odometry_samples)),
@@ -428,6 +429,12 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       for (const auto& [id, body] : body_of) all_static[id] = 0;
       map_update = slam_.UpdateMap(slam_frame, all_static);
     }
+  }
+  // Bundle adjustment time per run (solver wall time; in the back-end thread when
+  // slam.background_ba, so not part of this image's time), recorded when a run is merged.
+  if (slam_.ba_runs() != ba_runs_seen_) {
+    ba_runs_seen_ = slam_.ba_runs();
+    ba_timer_->Add(slam_.last_ba_seconds() * 1e3);
   }
   if (map_update.new_keyframe) UpdateGroundPlane();
   UpdateOccupancy(map_update, frame.utime, &result);

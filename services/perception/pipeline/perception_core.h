@@ -148,6 +148,7 @@ class PerceptionCore : public FrameProcessor {
   TimingStats* occupancy_timer_;
   TimingStats* objects_timer_;
   TimingStats* person_timer_;   // person checks (part of no other stage)
+  TimingStats* ba_timer_;       // bundle adjustment runs (solver time, back-end thread)
   TimingStats* outputs_timer_;  // map / track messages built for the sinks
   PoseBuffer odometry_;
   Rigid3d base_from_cam_;
@@ -169,6 +170,7 @@ class PerceptionCore : public FrameProcessor {
   std::future<std::vector<std::pair<int, bool>>> person_job_;
   std::map<int, int64_t> object_first_utime_;
   int64_t frame_index_ = -1;
+  int64_t ba_runs_seen_ = 0;
 };
 
 }  // namespace mbslam

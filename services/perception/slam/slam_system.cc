@@ -1,5 +1,8 @@
 #include "services/perception/slam/slam_system.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -742,6 +745,10 @@ void SlamSystem::StartBundleAdjustment(bool global) {
       map_, options_.ba.window_keyframes, global, focal_px_, metric_ && options_.use_odometry));
   ba_running_ = true;
   ba_thread_ = std::thread([this] {
+    // Lower priority than the per-image loop: on a 2-core robot computer the BA must not
+    // delay images (its result is merged whenever it is ready). Raising niceness is
+    // always permitted; a failure only leaves the default priority.
+    if (options_.background_ba_nice > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), options_.background_ba_nice);
     ba_summary_ = SolveBa(ba_problem_.get(), options_.ba);
     ba_running_ = false;
   });

@@ -61,6 +61,7 @@ struct SlamOptions {
   int lost_frames_to_reinit = 10;        // frames lost before the map is dropped and re-initialised (frames)
   int max_keyframes = 200;               // oldest keyframes are culled beyond this (count)
   bool background_ba = true;             // local BA in a back-end thread (realtime); false: inline (deterministic)
+  int background_ba_nice = 10;           // niceness of that thread (0-19): the per-image loop goes first
   bool use_odometry = true;              // odometry gives the prior motion and the metric scale
   double metric_min_baseline_m = 0.3;    // odometry baseline needed to fix the metric scale after initialisation (m)
   bool use_segmentation = true;          // feedback from segmentation: moving tracks never enter the map (false = ablation)
@@ -78,6 +79,7 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION_SECTION(pose);
     MBSLAM_CHECK_OPTION_SECTION(ba);
     MBSLAM_CHECK_OPTION_GE(init_min_tracks, 8);
+    MBSLAM_CHECK_OPTION(background_ba_nice >= 0 && background_ba_nice <= 19);
     MBSLAM_CHECK_OPTION_GT(init_min_parallax_deg, 0.0);
     MBSLAM_CHECK_OPTION_GE(init_min_points, 8);
     MBSLAM_CHECK_OPTION_GT(init_max_frames, 1);
@@ -120,6 +122,7 @@ struct SlamOptions {
     v("lost_frames_to_reinit", &lost_frames_to_reinit, "frames lost before re-initialising (frames)");
     v("max_keyframes", &max_keyframes, "keyframes kept (count)");
     v("background_ba", &background_ba, "local BA in a back-end thread (false: inline, deterministic)");
+    v("background_ba_nice", &background_ba_nice, "niceness of the back-end thread (0-19; the per-image loop goes first)");
     v("use_odometry", &use_odometry, "odometry as motion prior and metric scale");
     v("metric_min_baseline_m", &metric_min_baseline_m, "odometry baseline that fixes the metric scale (m)");
     v("use_segmentation", &use_segmentation, "segmentation feedback: moving tracks stay out of the map (false = ablation)");
