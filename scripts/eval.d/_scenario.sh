@@ -59,8 +59,11 @@ out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float
        "relative_scale_error": (sum(scales) / len(scales)) if scales else None,
        "predicted_hit_rate_1s": obj.get("volume_hit_rate") if obj.get("volumes_checked") else None,
        "predicted_hit_rate_0_5s": obj05.get("volume_hit_rate") if obj05.get("volumes_checked") else None,
+       "predicted_volume_ratio_1s": obj.get("volume_ratio_median"),
+       "predicted_volume_ratio_0_5s": obj05.get("volume_ratio_median"),
        "objects": [{k: o.get(k) for k in ("est_id", "name", "samples", "settled_samples", "pos_err_rel_settled_mean",
-                                          "pos_err_rel_at_settle", "relative_scale_error", "volume_hit_rate")} for o in objs],
+                                          "pos_err_rel_at_settle", "relative_scale_error", "volume_hit_rate",
+                                          "volume_ratio_median")} for o in objs],
        "timings_ms": {k: v.get("mean_ms") for k, v in summary.get("timings", {}).items()}}
 if ate_nf:
     out["ate_rel_path_no_feedback"] = ate_nf["ate_rmse_m"] / length if ("ate_rmse_m" in ate_nf and length > 0) else None
@@ -72,7 +75,8 @@ print(f"sim-{name}: ATE {pct(out['ate_rel_path'])} of {length:.2f} m, tracked {p
 if obj:
     print(f"  objects: {obj.get('est_objects')} estimated, {obj.get('matched')} matched of {obj.get('gt_bodies')}; "
           f"error/range from 2 s {out['object_pos_err_rel_2s']}, relative scale error {out['relative_scale_error']}, "
-          f"volumes hit +0.5 s {out['predicted_hit_rate_0_5s']} +1 s {out['predicted_hit_rate_1s']}")
+          f"volumes hit +0.5 s {out['predicted_hit_rate_0_5s']} +1 s {out['predicted_hit_rate_1s']} "
+          f"(median size x the true box: {out['predicted_volume_ratio_0_5s']} / {out['predicted_volume_ratio_1s']})")
 if occ:
     print(f"  occupancy: precision {occ.get('occupancy_precision')}, recall {occ.get('occupancy_recall')} (voxel {occ.get('resolution_m')} m)")
 if ate_nf:

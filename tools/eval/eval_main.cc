@@ -578,6 +578,7 @@ int RunObjects(const Args& args) {
         .Set("position_scaled_rmse_m", o.position_error_scaled.rmse);
     oj.Set("best_scale", o.best_scale).Set("relative_scale_error", o.relative_scale_error);
     oj.Set("depth_rmse_m", o.depth_error.rmse).Set("volume_hit_rate", o.hit_rate);
+    if (o.volume_ratio_median >= 0.0) oj.Set("volume_ratio_median", o.volume_ratio_median);
     oj.Set("settled_samples", o.settled_samples)
         .Set("pos_err_rel_settled_mean", o.rel_error_settled_mean)
         .Set("pos_err_rel_settled_median", o.rel_error_settled_median)
@@ -589,15 +590,16 @@ int RunObjects(const Args& args) {
     oj.Set("depth_error_over_time_m", series);
     list.Push(oj);
   }
-  std::printf("predicted volumes at %lld us: %d of %d contain the true centre (%.3f)\n",
+  std::printf("predicted volumes at %lld us: %d of %d contain the true centre (%.3f); median size %.2f x the true box\n",
               static_cast<long long>(options.horizon_us), result.volumes_hit,
-              result.volumes_checked, result.hit_rate);
+              result.volumes_checked, result.hit_rate, result.volume_ratio_median);
   Json j = Json::Object();
   j.Set("metric", "objects")
       .Set("est_objects", result.num_est_objects)
       .Set("gt_bodies", result.num_gt_bodies);
   j.Set("matched", result.objects.size()).Set("unmatched_est", result.unmatched_est);
   j.Set("volume_hit_rate", result.hit_rate).Set("volumes_checked", result.volumes_checked);
+  if (result.volume_ratio_median >= 0.0) j.Set("volume_ratio_median", result.volume_ratio_median);
   j.Set("settle_us", options.settle_us).Set("settled_samples", result.settled_samples);
   if (result.rel_error_settled_mean >= 0.0) j.Set("pos_err_rel_settled", result.rel_error_settled_mean);
   j.Set("camera_ate_rmse_m", ate.translation.rmse).Set("objects", list);

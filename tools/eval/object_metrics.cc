@@ -40,6 +40,12 @@ bool InterpolatePose(const Trajectory& poses, int64_t utime, int64_t max_gap_us,
 
 namespace {
 
+double MedianOrNegative(std::vector<double> v) {
+  if (v.empty()) return -1.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
 // Truth at the time of an estimate sample: nearest ground-truth sample within the
 // tolerance (ground truth is per image, estimates are per image too).
 bool TruthAt(const Trajectory& poses, int64_t utime, int64_t tolerance, Rigid3d* pose) {
@@ -135,7 +141,7 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     }
   }
   const std::vector<int> assignment = SolveAssignment(cost);
-  std::vector<double> all_rel;
+  std::vector<double> all_rel, all_ratios;
   for (size_t i = 0; i < est_list.size(); ++i) {
     const int j = assignment[i];
     if (j < 0 || cost(static_cast<Eigen::Index>(i), j) >= kForbidden) {
@@ -194,6 +200,7 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     r.depth_error = ErrorStats::From(depth);
     // Predicted volumes at the horizon: does the true centre lie inside the box?
     const Sim3d est_from_gt = gt_from_est.Inverse();
+    std::vector<double> ratios;
     for (const auto& s : est.samples) {
       for (const auto& v : s.volumes) {
         if (std::llabs(v.horizon_us - options.horizon_us) > options.horizon_tolerance_us) {
@@ -207,10 +214,18 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
         if (v.Contains(est_from_gt * body_pose.translation)) {
           ++r.volumes_hit;
         }
+        const double true_volume = body.extent.x() * body.extent.y() * body.extent.z();
+        if (true_volume > 0.0) {
+          const Eigen::Vector3d size = 2.0 * gt_from_est.scale * v.half_extent;
+          const double ratio = size.x() * size.y() * size.z() / true_volume;
+          ratios.push_back(ratio);
+          all_ratios.push_back(ratio);
+        }
       }
     }
     r.hit_rate =
         r.volumes_checked > 0 ? static_cast<double>(r.volumes_hit) / r.volumes_checked : 0.0;
+    r.volume_ratio_median = MedianOrNegative(ratios);
     result->volumes_checked += r.volumes_checked;
     result->volumes_hit += r.volumes_hit;
     result->objects.push_back(r);
@@ -221,6 +236,7 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     for (double e : all_rel) sum += e;
     result->rel_error_settled_mean = sum / static_cast<double>(all_rel.size());
   }
+  result->volume_ratio_median = MedianOrNegative(all_ratios);
   result->hit_rate = result->volumes_checked > 0
                          ? static_cast<double>(result->volumes_hit) / result->volumes_checked
                          : 0.0;

@@ -109,6 +109,9 @@ struct ObjectResult {
   int volumes_checked = 0;
   int volumes_hit = 0;  // true centre inside the predicted box
   double hit_rate = 0.0;
+  // Predicted box volume / true box volume (truth units) of the checked volumes: a hit
+  // rate bought with huge boxes shows here. Median; < 0 if none or no true extent.
+  double volume_ratio_median = -1.0;
 };
 
 struct ObjectsEvaluation {
@@ -119,6 +122,7 @@ struct ObjectsEvaluation {
   int volumes_checked = 0;
   int volumes_hit = 0;
   double hit_rate = 0.0;  // over all matched objects
+  double volume_ratio_median = -1.0;  // over all checked volumes of matched objects (see ObjectResult)
   // Over every settled sample of every matched object (see ObjectResult); < 0 if none.
   int settled_samples = 0;
   double rel_error_settled_mean = -1.0;

@@ -130,6 +130,9 @@ TEST(ObjectMetrics, PredictedVolumeHitRate) {
   EXPECT_EQ(r.objects[0].volumes_checked, 30);
   EXPECT_EQ(r.objects[0].volumes_hit, 15);
   EXPECT_DOUBLE_EQ(r.hit_rate, 0.5);
+  // Size of the predictions against the true box: 2 x 2 x 2 m over 4.2 x 1.8 x 1.5 m.
+  EXPECT_NEAR(r.objects[0].volume_ratio_median, 8.0 / (4.2 * 1.8 * 1.5), 1e-9);
+  EXPECT_NEAR(r.volume_ratio_median, 8.0 / (4.2 * 1.8 * 1.5), 1e-9);
 }
 
 TEST(PredictedVolume, OrientedContainment) {
