@@ -161,7 +161,11 @@ void MotionSegmenter::UpdateObjectModels(const SegmenterInput& in, int64_t ref) 
     if (static_cast<int>(xr.size()) < options_.min_model_tracks) continue;
     RelativeMotion m;
     std::vector<uint8_t> inliers;
-    if (!EstimateRelativeMotion(xr, xn, in.focal_px, options_.two_view, &m, &inliers).ok()) continue;
+    // Bounded: at a low inlier ratio an adaptive RANSAC runs to its maximum every image
+    // (tens of ms per object); a failed estimate only skips this image's membership update.
+    TwoViewOptions two_view = options_.two_view;
+    two_view.ransac_max_iterations = std::min(two_view.ransac_max_iterations, options_.object_model_max_iterations);
+    if (!EstimateRelativeMotion(xr, xn, in.focal_px, two_view, &m, &inliers).ok()) continue;
     obj.motion = m;
   }
   // Membership by the likelihood w.r.t. each modelled object: members that do not

@@ -32,6 +32,7 @@ namespace mbslam {
 struct SegmentationOptions {
   StaticLikelihoodOptions likelihood;
   TwoViewOptions two_view;
+  int object_model_max_iterations = 50;   // RANSAC iterations of each moving object's two-view model (count; per image and object)
   SubspaceClusteringOptions multibody;  // multi-view multibody initialisation (sec. 3.4)
   bool multibody_init = false;      // (re)initialise bodies by affine subspace clustering of the track window (near-affine views, e.g. Hopkins; not for forward motion)
   int multibody_min_frames = 10;    // window length needed for the first initialisation (frames)
@@ -66,6 +67,7 @@ struct SegmentationOptions {
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(likelihood);
     MBSLAM_CHECK_OPTION_SECTION(two_view);
+    MBSLAM_CHECK_OPTION_GE(object_model_max_iterations, 1);
     MBSLAM_CHECK_OPTION_SECTION(multibody);
     MBSLAM_CHECK_OPTION_GE(multibody_min_frames, 2);
     MBSLAM_CHECK_OPTION_GE(multibody_max_frames, multibody_min_frames);
@@ -93,6 +95,8 @@ struct SegmentationOptions {
   void VisitFields(V& v) {
     v("likelihood", &likelihood, "epipolar + Flow Vector Bound likelihood");
     v("two_view", &two_view, "robust two-view motion estimate");
+    v("object_model_max_iterations", &object_model_max_iterations,
+      "RANSAC iterations of each moving object's model per image (count)");
     v("multibody", &multibody, "multi-view multibody initialisation (subspace clustering)");
     v("multibody_init", &multibody_init, "(re)initialise bodies by clustering the track window");
     v("multibody_min_frames", &multibody_min_frames, "window for the first initialisation (frames)");

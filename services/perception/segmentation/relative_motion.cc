@@ -218,7 +218,7 @@ Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
 
   cv::Mat mask;
   cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC,
-                                   options.ransac_confidence, thresh, mask);
+                                   options.ransac_confidence, thresh, options.ransac_max_iterations, mask);
   if (E.empty() || E.rows != 3) return Status::Error("essential matrix RANSAC failed");
   cv::Mat R, t;
   const int good = cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask);

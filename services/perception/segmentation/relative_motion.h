@@ -45,6 +45,7 @@ struct TwoViewOptions {
   double ransac_confidence = 0.999;  // RANSAC confidence
   double min_parallax_px = 1.0;    // median rotation-compensated flow below this = pure rotation, no essential fit (px)
   int min_points = 12;             // fewer correspondences: no estimate (count)
+  int ransac_max_iterations = 1000;  // RANSAC iterations at most (count; bounds the cost at low inlier ratios)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(sigma_px, 0.0);
@@ -52,6 +53,7 @@ struct TwoViewOptions {
     MBSLAM_CHECK_OPTION(ransac_confidence > 0.0 && ransac_confidence < 1.0);
     MBSLAM_CHECK_OPTION_GE(min_parallax_px, 0.0);
     MBSLAM_CHECK_OPTION_GE(min_points, 8);
+    MBSLAM_CHECK_OPTION_GE(ransac_max_iterations, 1);
     return true;
   }
   template <typename V>
@@ -61,6 +63,7 @@ struct TwoViewOptions {
     v("ransac_confidence", &ransac_confidence, "RANSAC confidence");
     v("min_parallax_px", &min_parallax_px, "median rotation-compensated flow below this = pure rotation (px)");
     v("min_points", &min_points, "fewest correspondences for an estimate (count)");
+    v("ransac_max_iterations", &ransac_max_iterations, "RANSAC iterations at most (count)");
   }
 };
 
