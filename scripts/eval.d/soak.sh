@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Soak: looped live replay for N minutes (default 20), RSS trend beyond the map's own memory; --asan: LeakSanitizer build
 # Usage: scripts/eval.sh soak [MINUTES] [--asan] [--default-config] [--scenario NAME] [--set a.b=v ...]
-# By default the map is held bounded (slam.max_keyframes=40, occupancy off) as in the
+# By default the map is held small (slam.max_keyframes=40, occupancy off) as in the
 # slow soak test, so that a trend is a leak; --default-config runs the service's defaults
-# (map growth then shows in map_* and map_bounded).
+# (200 keyframes, local BA, occupancy: map growth shows in map_* and map_bounded).
+# Under --asan the RSS slope is reported but not judged (ASan's quarantine keeps freed
+# memory); the verdict is LeakSanitizer's.
 # perception_service (realtime) is fed by camera_driver looping a simulated sequence over
 # udpm:// inside a private network namespace (test/integration/soak.sh). --asan builds
 # build-asan-soak/ with -DMBSLAM_SANITIZE=address (AddressSanitizer alone, LeakSanitizer
@@ -31,7 +33,7 @@ done
 build="$MBSLAM_BUILD"
 if [[ "$asan" == 1 ]]; then
   build="$MBSLAM_ROOT/build-asan-soak"
-  echo "building $build (ASan + UBSan) ..." >&2
+  echo "building $build (AddressSanitizer alone: MBSLAM_SANITIZE=address) ..." >&2
   cmake -S "$MBSLAM_ROOT" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMBSLAM_SANITIZE=address \
     -DMBSLAM_BUILD_TESTS=ON -DMBSLAM_BUILD_DRIVERS=ON -DMBSLAM_BUILD_TOOLS=ON -DMBSLAM_BUILD_BENCH=OFF \
     >"$MBSLAM_EVAL_OUT/asan_build.log" 2>&1

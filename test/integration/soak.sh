@@ -10,11 +10,14 @@
 # the map's own memory (per-element costs of the SLAM map, the published OcTree) and minus
 # the trajectories kept for the output files must not trend up by more than --max-slope
 # (default 0.5 MB/min). Whether the map itself levelled
-# off is reported (map_bounded, growth over the second half): in a looped replay with the
-# defaults it does not (points re-triangulated every pass, the OcTree growing with
-# drift), so the soak test runs with a bounded map (slam.max_keyframes=40, no occupancy
-# map) where any trend is a leak; LeakSanitizer (--asan) covers every module. With an
-# AddressSanitizer build the LeakSanitizer report at exit must be clean.
+# off is reported (map_bounded: no growth over the second half, one-sided). The soak test
+# runs with a small map (slam.max_keyframes=40, no occupancy map) where any trend is a
+# leak; note that a map this small always gets a global BA (ba.global_max_keyframes=40),
+# which also removes under-observed points: --default-config is the run that exercises
+# culling with local BA only (map points left by culled keyframes once grew without
+# bound there). LeakSanitizer (--asan) covers every module. With an AddressSanitizer
+# build the LeakSanitizer report at exit must be clean and the RSS slope is not judged
+# (quarantine, shadow memory).
 # Prints a summary, then one JSON object as the LAST line. Exit 1 on a failed check.
 set -euo pipefail
 # The whole script is one function, read in full before it runs (editing the file during a
@@ -142,8 +145,13 @@ received = int(rows[-1]["frames_received"]) if rows else 0
 dropped = int(rows[-1]["frames_dropped"]) if rows else 0
 duration = t[-1] if t else 0.0
 r2 = lambda v: None if v is None else round(v, 4)
+# Under AddressSanitizer the RSS is no measure of retained memory: freed blocks stay in
+# its quarantine (256 MB by default) and every allocation has shadow and redzones, so
+# a 5-minute run grows by hundreds of MB without a leak. There the verdict is
+# LeakSanitizer's; the slopes are printed but not judged.
+slope_ok = asan == 1 or (slope_beyond is not None and slope_beyond <= max_slope)
 ok = (alive == 1 and exit_code == 0 and duration >= 0.95 * minutes and frames > 0 and
-      slope_beyond is not None and slope_beyond <= max_slope and (leaks in (None, 0)))
+      slope_ok and (leaks in (None, 0)))
 out = {
     "scenario": scenario, "duration_min": round(duration, 2), "samples": len(rows),
     "rss_start_mb": rss[0] if rss else None, "rss_end_mb": rss[-1] if rss else None,
@@ -160,18 +168,21 @@ out = {
     "map_keyframes_max": max((int(r["map_keyframes"]) for r in rows), default=0),
     "occupancy_mem_mb_end": round(float(rows[-1]["occupancy_mem_bytes"]) / MB, 2) if rows else None,
     "map_points_growth_per_min_2nd_half": r2(growth("map_points")),
-    "map_bounded": bool(rows) and abs(growth("map_points") or 0.0) <= 0.01 * max(1, max(int(r["map_points"]) for r in rows)) and
-                   abs(growth("occupancy_mem_bytes") or 0.0) <= 0.05 * MB,
+    # Bounded = not growing over the second half (a map shrinking or oscillating after
+    # culling is bounded too: the test is one-sided).
+    "map_bounded": bool(rows) and (growth("map_points") or 0.0) <= 0.01 * max(1, max(int(r["map_points"]) for r in rows)) and
+                   (growth("occupancy_mem_bytes") or 0.0) <= 0.05 * MB,
     "occupancy_mem_growth_mb_per_min_2nd_half": r2(None if growth("occupancy_mem_bytes") is None else growth("occupancy_mem_bytes") / MB),
     "frames": frames, "frames_received": received, "frames_dropped": dropped,
     "service_alive_at_end": bool(alive), "service_exit": exit_code,
-    "asan": bool(asan), "lsan_leaks": leaks, "passed": ok,
+    "asan": bool(asan), "lsan_leaks": leaks, "rss_slope_judged": asan != 1, "passed": ok,
 }
 print(f"soak ({scenario}, {duration:.1f} min{', ASan/LSan' if asan else ''}): RSS {out['rss_start_mb']} -> "
       f"{out['rss_end_mb']} MB (max {out['rss_max_mb']}); slope {out['rss_slope_mb_per_min']} MB/min, retained "
       f"{out['rss_retained_slope_mb_per_min']}, of which the map {out['map_mem_slope_mb_per_min']} and the "
       f"trajectories {out['trajectory_mem_slope_mb_per_min']}: "
-      f"beyond the map {out['rss_slope_beyond_map_mb_per_min']} MB/min (limit {max_slope})")
+      f"beyond the map {out['rss_slope_beyond_map_mb_per_min']} MB/min "
+      f"({'limit ' + str(max_slope) if asan != 1 else 'not judged under ASan: quarantine'})")
 print(f"  map at the end {out['map_mem_end_mb']} MB: {out['map_points_end']} points (max {out['map_points_max']}), "
       f"{out['map_keyframes_max']} keyframes max, OcTree {out['occupancy_mem_mb_end']} MB; second half: points "
       f"{out['map_points_growth_per_min_2nd_half']}/min, OcTree {out['occupancy_mem_growth_mb_per_min_2nd_half']} MB/min"

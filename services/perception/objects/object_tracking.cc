@@ -38,9 +38,12 @@ void ObjectTracking::Reset() {
 
 int ObjectTracking::PersistentId(int segment_id) {
   auto it = object_of_segment_.find(segment_id);
-  if (it != object_of_segment_.end()) return it->second;
+  if (it != object_of_segment_.end()) {
+    it->second.last_utime = utime_;
+    return it->second.id;
+  }
   const int id = next_id_++;
-  object_of_segment_[segment_id] = id;
+  object_of_segment_[segment_id] = SegmentLink{id, utime_};
   return id;
 }
 
@@ -66,8 +69,8 @@ int ObjectTracking::Reidentify(const ObjectFrame& frame, const ObjectObservation
   for (const auto& [id, s] : objects_) {
     if (taken.count(id) || !s.filter.initialized()) continue;
     bool seen_now = false;
-    for (const auto& [seg, obj] : object_of_segment_) {
-      if (obj == id && seg != o.id) {
+    for (const auto& [seg, link] : object_of_segment_) {
+      if (link.id == id && seg != o.id) {
         for (const ObjectObservation& other : frame.objects) seen_now |= other.id == seg;
       }
     }
@@ -148,6 +151,22 @@ Eigen::Vector2d ObjectTracking::MoveReference(State* s, const ObjectObservation&
 const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& frame) {
   out_.clear();
   if (!options_.enabled) return out_;
+  // Links of the segments in this image stay fresh; a link unused for forget_after_us
+  // goes (a segment the filters never took would otherwise keep its link for ever, and
+  // Reidentify reads them all).
+  utime_ = frame.utime;
+  for (const ObjectObservation& o : frame.objects) {
+    auto it = object_of_segment_.find(o.id);
+    if (it != object_of_segment_.end()) it->second.last_utime = frame.utime;
+  }
+  for (auto m = object_of_segment_.begin(); m != object_of_segment_.end();) {
+    if (frame.utime - m->second.last_utime > options_.forget_after_us) {
+      ++stats_.segment_ids_forgotten;
+      m = object_of_segment_.erase(m);
+    } else {
+      ++m;
+    }
+  }
   if (frame.rescaled_by) {
     for (auto& [id, s] : objects_) {
       s.filter.RescaleWorld(*frame.rescaled_by);
@@ -169,8 +188,8 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
     if (static_cast<int>(o.track_xy.size()) < options_.min_tracks || o.track_xy.size() != o.track_ids.size()) continue;
     int id = 0;
     auto known = object_of_segment_.find(o.id);
-    if (known != object_of_segment_.end() && !seen.count(known->second)) {
-      id = known->second;
+    if (known != object_of_segment_.end() && !seen.count(known->second.id)) {
+      id = known->second.id;
     } else {
       id = Reidentify(frame, o, seen);
       if (id != 0) ++stats_.reidentified;
@@ -184,7 +203,7 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
                .first;
       it->second.metres_per_unit = m;
     }
-    object_of_segment_[o.id] = id;
+    object_of_segment_[o.id] = SegmentLink{id, frame.utime};
     State& s = it->second;
     s.segment_id = o.id;
     bool restarted = false;
@@ -252,7 +271,7 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
       if (!s.filter.initialized() || frame.utime - s.last_seen_utime > options_.keep_unseen_us) {
         ++stats_.filters_dropped;
         for (auto m = object_of_segment_.begin(); m != object_of_segment_.end();) {
-          m = m->second == it->first ? object_of_segment_.erase(m) : std::next(m);
+          m = m->second.id == it->first ? object_of_segment_.erase(m) : std::next(m);
         }
         it = objects_.erase(it);
         continue;

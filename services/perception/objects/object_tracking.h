@@ -64,6 +64,9 @@ struct ObjectTrackingOptions {
   double unit_guess_m = 5.0;
   int min_tracks = 3;                   // an object with fewer tracks in an image is not observed (count)
   int64_t keep_unseen_us = 1000000;     // an unseen object is predicted and reported this long (µs)
+  // What is kept of an object once it is gone (its id per segment id, first-seen time,
+  // person class) is forgotten this long after it was last seen (µs); >= keep_unseen_us.
+  int64_t forget_after_us = 10000000;
   double depth_bound_margin = 0.2;      // the static depth behind the object, grown by this share
   double static_point_min_share = 0.3;  // previously static: share of its tracks with map points
   // The reference point is pulled toward the tracks' centroid by this share per image, so
@@ -79,6 +82,7 @@ struct ObjectTrackingOptions {
     MBSLAM_CHECK_OPTION_GT(unit_guess_m, 0.0);
     MBSLAM_CHECK_OPTION_GE(min_tracks, 1);
     MBSLAM_CHECK_OPTION_GE(keep_unseen_us, 0);
+    MBSLAM_CHECK_OPTION_GE(forget_after_us, keep_unseen_us);
     MBSLAM_CHECK_OPTION_GE(depth_bound_margin, 0.0);
     MBSLAM_CHECK_OPTION(static_point_min_share >= 0.0 && static_point_min_share <= 1.0);
     MBSLAM_CHECK_OPTION(reference_centroid_pull >= 0.0 && reference_centroid_pull < 1.0);
@@ -97,6 +101,9 @@ struct ObjectTrackingOptions {
       "metres per map unit assumed without odometry or camera height (m/unit)");
     v("min_tracks", &min_tracks, "fewer tracks in an image: the object is not observed (count)");
     v("keep_unseen_us", &keep_unseen_us, "an unseen object is predicted and reported this long (us)");
+    v("forget_after_us", &forget_after_us,
+      "what is kept of a gone object (id per segment, first-seen time, class) is forgotten this long after "
+      "it was last seen, >= keep_unseen_us (us)");
     v("depth_bound_margin", &depth_bound_margin, "static depth behind the object grown by this share");
     v("static_point_min_share", &static_point_min_share,
       "previously static object: share of its tracks with map points");
@@ -152,6 +159,7 @@ struct ObjectTrackingStats {
   int64_t rejected_updates = 0;     // observations a filter refused
   int64_t reference_restarts = 0;   // no track carried over: reference back at the centroid
   int64_t reidentified = 0;         // new segment ids recognised as objects already tracked
+  int64_t segment_ids_forgotten = 0;  // segment id -> object id links unused for forget_after_us
 };
 
 class ObjectTracking {
@@ -163,8 +171,9 @@ class ObjectTracking {
   void Reset();
 
   // The persistent id of a segmentation id (allocated if new): for segments the filters
-  // did not take in this image (too few tracks, no static pose).
+  // did not take in this image (too few tracks, no static pose). Call after Update.
   int PersistentId(int segment_id);
+  size_t num_segment_links() const { return object_of_segment_.size(); }
   // Metres per map unit this image would use (see the header comment).
   double MetresPerUnit(const ObjectFrame& frame) const;
   const ObjectTrackingStats& stats() const { return stats_; }
@@ -190,7 +199,12 @@ class ObjectTracking {
 
   ObjectTrackingOptions options_;
   std::map<int, State> objects_;       // by persistent id
-  std::map<int, int> object_of_segment_;  // segment id -> persistent id
+  struct SegmentLink {
+    int id = 0;                 // persistent id
+    int64_t last_utime = 0;     // image time the segment was last seen
+  };
+  std::map<int, SegmentLink> object_of_segment_;  // segment id -> persistent id
+  int64_t utime_ = 0;                             // the latest image's time
   int next_id_ = 1;
   std::vector<TrackedObject> out_;
   ObjectTrackingStats stats_;

@@ -133,6 +133,39 @@ TEST(ObjectTracking, PredictsWhileUnseenThenDrops) {
   EXPECT_EQ(tracking.stats().filters_dropped, 1);
 }
 
+// Segment ids the filters never took (too few tracks) still get a persistent id, and
+// a re-labelled object leaves its old segment id behind: such links are forgotten
+// forget_after_us after their segment was last seen, or a long run keeps them all.
+TEST(ObjectTracking, ForgetsSegmentLinksOfGoneSegments) {
+  ObjectTrackingOptions options;
+  options.keep_unseen_us = 300000;
+  options.forget_after_us = 2000000;
+  ObjectTracking tracking(options);
+  ObjectFrame f;
+  f.pose_valid = false;  // no filter starts: links only through PersistentId
+  int64_t t = 1000000;
+  int kept_id = 0;
+  for (int i = 0; i < 100; ++i, t += 100000) {  // 10 s at 10 Hz
+    f.utime = t;
+    f.objects.clear();
+    ObjectObservation kept;  // segment 5 is seen throughout
+    kept.id = 5;
+    f.objects.push_back(kept);
+    tracking.Update(f);
+    const int id = tracking.PersistentId(5);
+    if (kept_id == 0) kept_id = id;
+    EXPECT_EQ(id, kept_id) << "image " << i;
+    if (i < 10) tracking.PersistentId(100 + i);  // ten short-lived segments in the first second
+  }
+  // The short-lived ones were last seen 9 s ago (> 2 s): gone; segment 5 stays.
+  EXPECT_EQ(tracking.num_segment_links(), 1u);
+  EXPECT_EQ(tracking.stats().segment_ids_forgotten, 10);
+  EXPECT_EQ(tracking.PersistentId(5), kept_id);
+  // A forgotten segment id seen again is a new object.
+  EXPECT_NE(tracking.PersistentId(100), kept_id);
+  EXPECT_EQ(tracking.num_segment_links(), 2u);
+}
+
 TEST(ObjectTracking, MetresPerUnitFromCameraHeight) {
   ObjectTrackingOptions options;
   options.unit_guess_m = 7.0;

@@ -68,11 +68,15 @@ inline constexpr const char* kImageWithoutOdometry = "image_without_odometry";  
 inline constexpr const char* kOdometryGap = "odometry_gap";                     // odometry resumed after a gap
 inline constexpr const char* kTrackingLost = "tracking_lost";                   // camera tracking state left OK
 inline constexpr const char* kTrackingRecovered = "tracking_recovered";         // back to OK after a loss
+inline constexpr const char* kMapPointsCulled = "map_points_culled";            // left with their culled keyframes
+inline constexpr const char* kObjectRecordsPruned = "object_records_pruned";    // per-object state of objects gone
 }  // namespace counter
 
-// Counters that report recoveries, not problems: they do not make the state DEGRADED.
+// Counters that report recoveries or routine housekeeping, not problems: they do not make
+// the state DEGRADED.
 inline bool IsInformationalCounter(const std::string& name) {
-  return name == counter::kTrackingRecovered;
+  return name == counter::kTrackingRecovered || name == counter::kMapPointsCulled ||
+         name == counter::kObjectRecordsPruned;
 }
 
 }  // namespace mbslam

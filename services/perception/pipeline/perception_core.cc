@@ -51,8 +51,30 @@ void PerceptionCore::Reset() {
   occluders_.clear();
   if (person_job_.valid()) person_job_.wait();
   person_job_ = {};
-  person_checked_.clear();
-  is_person_.clear();
+  object_records_.clear();
+}
+
+PerceptionCore::ObjectRecord& PerceptionCore::RecordOf(int id, int64_t utime) {
+  auto [it, inserted] = object_records_.try_emplace(id);
+  if (inserted) it->second.first_utime = utime;
+  it->second.last_utime = std::max(it->second.last_utime, utime);
+  return it->second;
+}
+
+void PerceptionCore::ForgetGoneObjects(int64_t utime) {
+  int64_t forgotten = 0;
+  for (auto it = object_records_.begin(); it != object_records_.end();) {
+    if (utime - it->second.last_utime > options_.objects.forget_after_us) {
+      it = object_records_.erase(it);
+      ++forgotten;
+    } else {
+      ++it;
+    }
+  }
+  const int64_t links = object_tracking_.stats().segment_ids_forgotten;
+  forgotten += links - segment_links_forgotten_;
+  segment_links_forgotten_ = links;
+  if (forgotten > 0) counters_->Increment(counter::kObjectRecordsPruned, forgotten);
 }
 
 void PerceptionCore::OnOdometry(const OdometrySample& odometry) {
@@ -436,6 +458,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     ba_runs_seen_ = slam_.ba_runs();
     ba_timer_->Add(slam_.last_ba_seconds() * 1e3);
   }
+  if (map_update.culled_points > 0) counters_->Increment(counter::kMapPointsCulled, map_update.culled_points);
   if (map_update.new_keyframe) UpdateGroundPlane();
   UpdateOccupancy(map_update, frame.utime, &result);
   if (map_update.rescaled_by && ground_) ground_->Rescale(*map_update.rescaled_by);
@@ -540,9 +563,11 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     for (const SegmentedObject& o : seg.objects) {
       if (o.hull.size() < 3) continue;
       const int oid = object_id_of[o.id];
-      auto last = person_checked_.find(oid);
-      const int64_t last_frame = last == person_checked_.end() ? std::numeric_limits<int64_t>::min() : last->second;
-      if (last == person_checked_.end() || frame_index_ - last_frame >= options_.person.every_n_frames) {
+      auto rec = object_records_.find(oid);
+      const std::optional<int64_t> last =
+          rec == object_records_.end() ? std::nullopt : rec->second.person_checked_frame;
+      const int64_t last_frame = last ? *last : std::numeric_limits<int64_t>::min();
+      if (!last || frame_index_ - last_frame >= options_.person.every_n_frames) {
         due.emplace_back(last_frame, oid);
       }
     }
@@ -564,8 +589,8 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       FillObjectEstimate(*tr->second, &out);
       tracked_of.erase(tr);
     }
-    auto [first, inserted] = object_first_utime_.try_emplace(oid, frame.utime);
-    out.first_seen_utime = first->second;
+    ObjectRecord& record = RecordOf(oid, frame.utime);
+    out.first_seen_utime = record.first_utime;
     out.num_tracks = static_cast<int>(o.track_ids.size());
     HullOutput hull;
     hull.body_id = oid;
@@ -583,9 +608,9 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     if (person_check_due.count(oid) && hull.points.size() >= 3) {
       person_boxes.emplace_back(oid, cv::Rect(static_cast<int>(min_x), static_cast<int>(min_y),
                                               static_cast<int>(max_x - min_x), static_cast<int>(max_y - min_y)));
-      person_checked_[oid] = frame_index_;
+      record.person_checked_frame = frame_index_;
     }
-    out.object_class = is_person_[oid] ? ObjectClass::kPerson : ObjectClass::kUnknown;
+    out.object_class = record.is_person ? ObjectClass::kPerson : ObjectClass::kUnknown;
     out.hull = hull;
     result.hulls.push_back(hull);
     if (occ.points.size() >= 3) occluders_.push_back(std::move(occ));
@@ -596,9 +621,11 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   for (const auto& [id, t] : tracked_of) {
     ObjectOutput out;
     out.id = id;
-    auto first = object_first_utime_.find(id);
-    out.first_seen_utime = first != object_first_utime_.end() ? first->second : t->last_seen_utime;
-    out.object_class = is_person_[id] ? ObjectClass::kPerson : ObjectClass::kUnknown;
+    const bool known = object_records_.count(id) > 0;
+    ObjectRecord& record = RecordOf(id, frame.utime);
+    if (!known) record.first_utime = t->last_seen_utime;
+    out.first_seen_utime = record.first_utime;
+    out.object_class = record.is_person ? ObjectClass::kPerson : ObjectClass::kUnknown;
     FillObjectEstimate(*t, &out);
     result.objects.push_back(std::move(out));
   }
@@ -610,6 +637,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       return found;
     });
   }
+  ForgetGoneObjects(frame.utime);
   result.epipole = seg.epipole;
 
   for (const Track& t : tracker_.tracks()) {
@@ -641,7 +669,8 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
 void PerceptionCore::CollectPersonChecks() {
   if (!person_job_.valid()) return;
   for (const auto& [id, found] : person_job_.get()) {
-    if (found) is_person_[id] = true;
+    auto it = object_records_.find(id);  // forgotten meanwhile: nothing to mark
+    if (found && it != object_records_.end()) it->second.is_person = true;
   }
 }
 

@@ -10,6 +10,7 @@
 #include <future>
 #include <map>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -122,6 +123,7 @@ class PerceptionCore : public FrameProcessor {
 
   const PoseBuffer& odometry() const { return odometry_; }
   const SlamSystem& slam() const { return slam_; }
+  size_t num_object_records() const { return object_records_.size(); }
   void Finish() override { slam_.Flush(); }
 
  private:
@@ -136,7 +138,7 @@ class PerceptionCore : public FrameProcessor {
   MapOutput BuildMapOutput(int64_t utime) const;
   void FillObjectEstimate(const TrackedObject& tracked, ObjectOutput* out) const;
   void Reset();
-  void CollectPersonChecks();  // results of the previous image's person checks into is_person_
+  void CollectPersonChecks();  // results of the previous image's person checks into object_records_
 
   const CoreOptions options_;
   Counters* counters_;
@@ -164,11 +166,20 @@ class PerceptionCore : public FrameProcessor {
   std::vector<cv::Mat> pyramid_;
   std::map<int64_t, int64_t> frame_utime_;   // frame index -> image time (recent frames)
   std::vector<TrackingHints::Hull> occluders_;  // moving objects' hulls predicted for the next image
-  std::map<int, int64_t> person_checked_;    // object id -> frame of the last person check
-  std::map<int, bool> is_person_;
+  // What is kept per reported object id, forgotten objects.forget_after_us after the
+  // object was last reported (ids are never reused; a long run meets ever new ones).
+  struct ObjectRecord {
+    int64_t first_utime = 0;             // first reported (first_seen_utime)
+    int64_t last_utime = 0;              // last reported
+    std::optional<int64_t> person_checked_frame;  // frame of the last person check
+    bool is_person = false;
+  };
+  ObjectRecord& RecordOf(int id, int64_t utime);
+  void ForgetGoneObjects(int64_t utime);
+  std::map<int, ObjectRecord> object_records_;
+  int64_t segment_links_forgotten_ = 0;  // object_tracking_'s count already reported
   // Person checks of the previous image, running on another thread (object id, found).
   std::future<std::vector<std::pair<int, bool>>> person_job_;
-  std::map<int, int64_t> object_first_utime_;
   int64_t frame_index_ = -1;
   int64_t ba_runs_seen_ = 0;
 };

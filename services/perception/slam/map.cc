@@ -50,6 +50,16 @@ void Map::RemovePoint(int64_t point_id) {
   points_.erase(it);
 }
 
+int Map::RemoveStalePoints(int64_t seen_before_frame) {
+  std::vector<int64_t> stale;
+  for (const auto& [id, p] : points_) {
+    if (p.observations.size() >= 2) continue;
+    if (p.track_id < 0 || p.last_seen_frame < seen_before_frame) stale.push_back(id);
+  }
+  for (int64_t id : stale) RemovePoint(id);
+  return static_cast<int>(stale.size());
+}
+
 void Map::Clear() {
   keyframes_.clear();
   points_.clear();

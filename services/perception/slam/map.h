@@ -56,6 +56,12 @@ class Map {
   int64_t AddPoint(MapPoint point);
   void AddObservation(int64_t point_id, int64_t keyframe_id, const Eigen::Vector2d& xy);
   void RemovePoint(int64_t point_id);
+  // Points held by fewer than two keyframes (culling took the others) that no track
+  // still matches: without a track (released) or not matched since `seen_before_frame`
+  // (the track died or stays lost). Keyframe culling spares such points while a track
+  // holds them; nothing else would ever remove them once their keyframes are gone.
+  // Returns how many were removed.
+  int RemoveStalePoints(int64_t seen_before_frame);
   void Clear();
 
   MapPoint* point(int64_t id);

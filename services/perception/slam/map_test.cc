@@ -37,5 +37,42 @@ TEST(Map, TracksPointsAndSaveLoadRoundTrip) {
   EXPECT_FALSE(bad.Load("/nonexistent").ok());
 }
 
+// Keyframe culling leaves points with fewer than two observations when a track still
+// holds them; once the track no longer matches them they must go, or a long run keeps
+// every point it ever made (soak with the default configuration).
+TEST(Map, RemoveStalePointsDropsUnderObservedPointsNoTrackMatches) {
+  Map map;
+  const int64_t k0 = map.AddKeyframe(Keyframe());
+  const int64_t k1 = map.AddKeyframe(Keyframe());
+  auto add = [&](int64_t track, int64_t last_seen, std::vector<int64_t> kfs) {
+    MapPoint p;
+    p.track_id = track;
+    p.last_seen_frame = last_seen;
+    const int64_t id = map.AddPoint(p);
+    for (int64_t k : kfs) map.AddObservation(id, k, Eigen::Vector2d::Zero());
+    return id;
+  };
+  const int64_t two_views_old = add(-1, 0, {k0, k1});   // well observed: kept however old
+  const int64_t one_view_fresh = add(7, 100, {k1});     // its track still matches it: kept
+  const int64_t one_view_stale = add(8, 40, {k1});      // track died long ago: removed
+  const int64_t no_view_released = add(-1, 100, {});    // no track, no keyframe: removed
+  const int64_t no_view_fresh = add(9, 95, {});         // tracked right now: kept
+  EXPECT_EQ(map.RemoveStalePoints(/*seen_before_frame=*/70), 2);
+  EXPECT_NE(map.point(two_views_old), nullptr);
+  EXPECT_NE(map.point(one_view_fresh), nullptr);
+  EXPECT_EQ(map.point(one_view_stale), nullptr);
+  EXPECT_EQ(map.point(no_view_released), nullptr);
+  EXPECT_NE(map.point(no_view_fresh), nullptr);
+  // The removed point left its keyframe and its track.
+  EXPECT_EQ(map.PointOfTrack(8), -1);
+  EXPECT_EQ(map.PointOfTrack(7), one_view_fresh);
+  EXPECT_EQ(map.keyframe(k1)->point_ids.size(), 2u);
+  EXPECT_EQ(map.num_points(), 3u);
+  // Later, the fresh one-view point's track stops matching too.
+  EXPECT_EQ(map.RemoveStalePoints(/*seen_before_frame=*/101), 2);
+  EXPECT_EQ(map.num_points(), 1u);
+  EXPECT_EQ(map.RemoveStalePoints(1000), 0);
+}
+
 }  // namespace
 }  // namespace mbslam

@@ -629,7 +629,7 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
   tracked_points_at_keyframe_ = tracked + static_cast<int>(update->new_point_ids.size());
   last_keyframe_frame_ = frame.frame_index;
   update->new_keyframe = true;
-  CullKeyframes();
+  update->culled_points = CullKeyframes(frame.frame_index);
 }
 
 std::optional<double> SlamSystem::EstablishMetricScale() {
@@ -662,7 +662,8 @@ std::optional<double> SlamSystem::EstablishMetricScale() {
   return s;
 }
 
-void SlamSystem::CullKeyframes() {
+int SlamSystem::CullKeyframes(int64_t frame_index) {
+  int removed = 0;
   while (static_cast<int>(map_.num_keyframes()) > options_.max_keyframes) {
     auto oldest = map_.keyframes().begin();
     const int64_t id = oldest->first;
@@ -674,11 +675,19 @@ void SlamSystem::CullKeyframes() {
       p->observations.erase(std::remove_if(p->observations.begin(), p->observations.end(),
                                            [id](const Observation& o) { return o.keyframe_id == id; }),
                             p->observations.end());
-      if (p->observations.size() < 2 && p->track_id < 0) map_.RemovePoint(pid);
+      if (p->observations.size() < 2 && p->track_id < 0) {
+        map_.RemovePoint(pid);
+        ++removed;
+      }
     }
     map_.keyframes().erase(id);
     if (was_fixed && !map_.keyframes().empty()) map_.keyframes().begin()->second.fixed = true;
   }
+  // Points spared above because a track still held them: once that track has died or
+  // stopped matching them (a track's end is not reported to the map), nothing else would
+  // remove them and a long run would keep every point it ever made.
+  removed += map_.RemoveStalePoints(frame_index - options_.culled_point_max_unmatched_frames);
+  return removed;
 }
 
 SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) {

@@ -60,6 +60,7 @@ struct SlamOptions {
   int min_tracking_inliers = 20;         // fewer inliers = tracking lost (count)
   int lost_frames_to_reinit = 10;        // frames lost before the map is dropped and re-initialised (frames)
   int max_keyframes = 200;               // oldest keyframes are culled beyond this (count)
+  int culled_point_max_unmatched_frames = 30;  // a point culling left in < 2 keyframes goes once its track has not matched it this long (frames)
   bool background_ba = true;             // local BA in a back-end thread (realtime); false: inline (deterministic)
   int background_ba_nice = 10;           // niceness of that thread (0-19): the per-image loop goes first
   bool use_odometry = true;              // odometry gives the prior motion and the metric scale
@@ -95,6 +96,7 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION_GE(min_tracking_inliers, 6);
     MBSLAM_CHECK_OPTION_GE(lost_frames_to_reinit, 1);
     MBSLAM_CHECK_OPTION_GE(max_keyframes, 3);
+    MBSLAM_CHECK_OPTION_GE(culled_point_max_unmatched_frames, 1);
     MBSLAM_CHECK_OPTION(depth_bound_margin > 0.0 && depth_bound_margin < 1.0);
     MBSLAM_CHECK_OPTION_GT(frustum_bound_factor, 1.0);
     MBSLAM_CHECK_OPTION_GT(metric_min_baseline_m, 0.0);
@@ -121,6 +123,9 @@ struct SlamOptions {
     v("min_tracking_inliers", &min_tracking_inliers, "fewer inliers = lost (count)");
     v("lost_frames_to_reinit", &lost_frames_to_reinit, "frames lost before re-initialising (frames)");
     v("max_keyframes", &max_keyframes, "keyframes kept (count)");
+    v("culled_point_max_unmatched_frames", &culled_point_max_unmatched_frames,
+      "a point left in fewer than two keyframes by culling is removed once its track has not matched it "
+      "for this long (frames)");
     v("background_ba", &background_ba, "local BA in a back-end thread (false: inline, deterministic)");
     v("background_ba_nice", &background_ba_nice, "niceness of the back-end thread (0-19; the per-image loop goes first)");
     v("use_odometry", &use_odometry, "odometry as motion prior and metric scale");
@@ -186,6 +191,7 @@ struct SlamMapUpdate {
   std::vector<int64_t> new_point_ids;      // triangulated at this keyframe (occupancy rays)
   std::vector<Eigen::Vector3d> released_points;  // static points whose tracks started moving (object seeds)
   std::vector<int64_t> released_tracks;
+  int culled_points = 0;                   // points removed with the culled keyframes (count)
 };
 
 class SlamSystem {
@@ -235,7 +241,9 @@ class SlamSystem {
   bool NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const;
   void StartBundleAdjustment(bool global);
   void MergeBundleAdjustment(bool wait);
-  void CullKeyframes();
+  // Oldest keyframes beyond max_keyframes, with the points they leave unobserved; returns
+  // the number of points removed.
+  int CullKeyframes(int64_t frame_index);
   // Without odometry at the initial views, the map becomes metric once two keyframes
   // with odometry are far enough apart.
   std::optional<double> EstablishMetricScale();
