@@ -1,5 +1,6 @@
 #include "services/perception/objects/ground_plane.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -31,9 +32,26 @@ std::optional<GroundPlane> GroundPlane::FromVector4(const Eigen::Vector4d& plane
 
 namespace {
 
-// Least-squares plane through `points[indices]`, normal oriented along `up`.
+// Orthonormal basis (columns) of the directions perpendicular to `in_plane`.
+Eigen::MatrixXd NormalSpace(const std::vector<Eigen::Vector3d>& in_plane) {
+  std::vector<Eigen::Vector3d> basis;  // Gram-Schmidt of the in-plane directions
+  for (const Eigen::Vector3d& d : in_plane) {
+    Eigen::Vector3d v = d;
+    for (const Eigen::Vector3d& b : basis) v -= b.dot(v) * b;
+    if (v.allFinite() && v.norm() > 1e-9 * std::max(1.0, d.norm())) basis.push_back(v.normalized());
+    if (basis.size() == 2) break;
+  }
+  Eigen::Matrix3d P = Eigen::Matrix3d::Identity();
+  for (const Eigen::Vector3d& b : basis) P -= b * b.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(P);  // eigenvalues 0 (in plane) or 1
+  const int k = 3 - static_cast<int>(basis.size());
+  return eig.eigenvectors().rightCols(k);
+}
+
+// Least-squares plane through `points[indices]`, normal oriented along `up` and within the
+// span of `Q`'s columns.
 bool FitPlane(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& indices,
-              const Eigen::Vector3d& up, GroundPlane* plane) {
+              const Eigen::Vector3d& up, const Eigen::MatrixXd& Q, GroundPlane* plane) {
   if (indices.size() < 3) return false;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (int i : indices) mean += points[static_cast<size_t>(i)];
@@ -43,9 +61,10 @@ bool FitPlane(const std::vector<Eigen::Vector3d>& points, const std::vector<int>
     const Eigen::Vector3d d = points[static_cast<size_t>(i)] - mean;
     cov += d * d.transpose();
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const Eigen::MatrixXd reduced = Q.transpose() * cov * Q;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(reduced);
   if (eig.info() != Eigen::Success) return false;
-  Eigen::Vector3d n = eig.eigenvectors().col(0);  // smallest eigenvalue first
+  Eigen::Vector3d n = Q * eig.eigenvectors().col(0);  // smallest eigenvalue first
   if (!n.allFinite() || n.norm() < 1e-12) return false;
   n.normalize();
   if (n.dot(up) < 0.0) n = -n;
@@ -67,6 +86,36 @@ void CollectInliers(const std::vector<Eigen::Vector3d>& points, const GroundPlan
 Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
                            const Eigen::Vector3d& up_hint, const GroundPlaneOptions& options,
                            GroundPlaneEstimate* estimate) {
+  return EstimateGroundPlane(points, up_hint, options, {}, estimate);
+}
+
+std::vector<Eigen::Vector3d> SpreadDirections(const std::vector<Eigen::Vector3d>& centres,
+                                              const Eigen::Vector3d& up, double max_tilt_deg,
+                                              double min_spread) {
+  std::vector<Eigen::Vector3d> out;
+  if (centres.size() < 2 || !up.allFinite() || up.norm() < 1e-12) return out;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& c : centres) mean += c;
+  mean /= static_cast<double>(centres.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& c : centres) cov += (c - mean) * (c - mean).transpose();
+  cov /= static_cast<double>(centres.size());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  if (eig.info() != Eigen::Success) return out;
+  const double sin_tilt = std::sin(max_tilt_deg * M_PI / 180.0);
+  for (int k = 2; k >= 0; --k) {  // largest spread first
+    const double spread = std::sqrt(std::max(0.0, eig.eigenvalues()[k]));
+    if (!(spread >= min_spread)) break;
+    const Eigen::Vector3d d = eig.eigenvectors().col(k);
+    if (std::abs(d.dot(up.normalized())) <= sin_tilt) out.push_back(d);
+  }
+  return out;
+}
+
+Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
+                           const Eigen::Vector3d& up_hint, const GroundPlaneOptions& options,
+                           const std::vector<Eigen::Vector3d>& in_plane_directions,
+                           GroundPlaneEstimate* estimate) {
   if (estimate == nullptr) return Status::Error("EstimateGroundPlane: null output");
   if (!options.Check()) return Status::Error("ground plane options: " + LastOptionError());
   if (!up_hint.allFinite() || up_hint.norm() < 1e-12) {
@@ -83,6 +132,8 @@ Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
     return Status::Error("EstimateGroundPlane: " + std::to_string(n) + " finite points, need 3");
   }
   const double cos_tilt = std::cos(options.max_tilt_deg * M_PI / 180.0);
+  const Eigen::MatrixXd Q = NormalSpace(in_plane_directions);
+  const bool constrained = Q.cols() < 3;
   ParticleRng rng(static_cast<uint64_t>(options.seed));
 
   int best_count = 0;
@@ -96,6 +147,7 @@ Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
     const Eigen::Vector3d& pa = finite[static_cast<size_t>(a)];
     Eigen::Vector3d normal =
         (finite[static_cast<size_t>(b)] - pa).cross(finite[static_cast<size_t>(c)] - pa);
+    if (constrained) normal = Q * (Q.transpose() * normal);
     const double norm = normal.norm();
     if (norm < 1e-12) continue;
     normal /= norm;
@@ -127,7 +179,7 @@ Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
   CollectInliers(finite, best, options.inlier_threshold, &inliers);
   for (int r = 0; r < options.refine_iterations; ++r) {
     GroundPlane refined;
-    if (!FitPlane(finite, inliers, up, &refined)) break;
+    if (!FitPlane(finite, inliers, up, Q, &refined)) break;
     if (refined.normal.dot(up) < cos_tilt) break;
     std::vector<int> next;
     CollectInliers(finite, refined, options.inlier_threshold, &next);

@@ -42,6 +42,11 @@ struct GroundPlaneOptions {
   int min_inliers = 20;            // fewer inliers: no plane (count)
   double min_inlier_ratio = 0.05;  // ... or a smaller share of the points: no plane [0, 1]
   int refine_iterations = 3;       // least-squares refits with re-selected inliers (count)
+  // A camera riding at a constant height (a known mounting height, see
+  // objects.camera_height_m) travels parallel to the ground: the plane's normal is kept
+  // perpendicular to the near-horizontal directions its keyframes spread along by at least
+  // this many camera heights (standard deviation of the centres); 0 = never.
+  double path_parallel_min_spread = 1.0;
   int64_t seed = 1;                // RANSAC sampling seed (deterministic)
 
   bool Check() const {
@@ -51,6 +56,7 @@ struct GroundPlaneOptions {
     MBSLAM_CHECK_OPTION_GE(min_inliers, 3);
     MBSLAM_CHECK_OPTION(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GE(refine_iterations, 0);
+    MBSLAM_CHECK_OPTION_GE(path_parallel_min_spread, 0.0);
     return true;
   }
   template <typename V>
@@ -61,6 +67,8 @@ struct GroundPlaneOptions {
     v("min_inliers", &min_inliers, "fewer inliers: no plane (count)");
     v("min_inlier_ratio", &min_inlier_ratio, "smaller inlier share: no plane [0, 1]");
     v("refine_iterations", &refine_iterations, "least-squares refits (count)");
+    v("path_parallel_min_spread", &path_parallel_min_spread,
+      "camera at a known height: normal perpendicular to keyframe spreads of at least this many camera heights; 0 never");
     v("seed", &seed, "RANSAC sampling seed");
   }
 };
@@ -80,6 +88,19 @@ Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
                            GroundPlaneEstimate* estimate);
 Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
                            const Eigen::Vector3d& up_hint, GroundPlaneEstimate* estimate);
+// The same with the normal constrained perpendicular to `in_plane_directions` (directions
+// known to lie in the ground plane, e.g. the travel of a camera at a constant height;
+// at most two, not parallel; need not be unit).
+Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
+                           const Eigen::Vector3d& up_hint, const GroundPlaneOptions& options,
+                           const std::vector<Eigen::Vector3d>& in_plane_directions,
+                           GroundPlaneEstimate* estimate);
+// Near-horizontal directions (w.r.t. `up`, within max_tilt_deg of the horizontal) along
+// which `centres` spread with a standard deviation of at least `min_spread` (units): the
+// principal axes of the centres.
+std::vector<Eigen::Vector3d> SpreadDirections(const std::vector<Eigen::Vector3d>& centres,
+                                              const Eigen::Vector3d& up, double max_tilt_deg,
+                                              double min_spread);
 
 }  // namespace mbslam
 

@@ -97,5 +97,40 @@ TEST(GroundPlane, Vector4RoundTripAndRescale) {
   EXPECT_NEAR(h.Height(Eigen::Vector3d(0, 0, 1)), 4.0, 1e-12);  // offset 1.5 -> 3
 }
 
+// Ground points whose height error grows with the distance along x (a slightly wrong
+// depth of far points): alone they fit a plane tilted about y. A camera that travelled
+// along x at a constant height says the ground contains x: the constrained normal has no
+// x component, and the camera's height above the plane no longer changes along its path.
+TEST(GroundPlane, NormalPerpendicularToTheCamerasTravel) {
+  ParticleRng rng(5);
+  std::vector<Eigen::Vector3d> points;
+  const double tilt = 2.0 * M_PI / 180.0;
+  for (int i = 0; i < 800; ++i) {
+    const double x = rng.Uniform(2, 30), y = rng.Uniform(-6, 6);
+    points.emplace_back(x, y, -1.0 + std::tan(tilt) * x + rng.Normal(0.0, 0.005));
+  }
+  GroundPlaneOptions options;
+  options.inlier_threshold = 0.05;
+  GroundPlaneEstimate free_fit, along;
+  ASSERT_TRUE(EstimateGroundPlane(points, Eigen::Vector3d::UnitZ(), options, &free_fit).ok());
+  EXPECT_GT(std::abs(free_fit.plane.normal.x()), 0.5 * std::sin(tilt));  // tilted with the data
+  EXPECT_GT(std::abs(free_fit.plane.Height(Eigen::Vector3d::Zero()) - free_fit.plane.Height(Eigen::Vector3d(9, 0, 0))), 0.1);
+  // Keyframe centres along x at height 0 (z bobs a little): one travel direction.
+  std::vector<Eigen::Vector3d> centres;
+  for (int k = 0; k < 20; ++k) centres.emplace_back(0.5 * k, 0.01 * (k % 2), 0.0);
+  const std::vector<Eigen::Vector3d> dirs = SpreadDirections(centres, Eigen::Vector3d::UnitZ(), 25.0, 1.0);
+  ASSERT_EQ(dirs.size(), 1u);
+  EXPECT_GT(std::abs(dirs[0].x()), 0.99);
+  EXPECT_TRUE(SpreadDirections(centres, Eigen::Vector3d::UnitZ(), 25.0, 10.0).empty());  // too short
+  ASSERT_TRUE(EstimateGroundPlane(points, Eigen::Vector3d::UnitZ(), options, dirs, &along).ok());
+  EXPECT_LT(std::abs(along.plane.normal.x()), 1e-4);  // free fit: 0.035
+  EXPECT_GT(along.plane.normal.z(), 0.99);
+  EXPECT_NEAR(along.plane.Height(centres[0]), along.plane.Height(centres[18]), 1e-4);  // free fit: 0.3
+  // A vertical spread (a camera moving up and down) is no ground direction.
+  std::vector<Eigen::Vector3d> lift;
+  for (int k = 0; k < 20; ++k) lift.emplace_back(0.0, 0.0, 0.5 * k);
+  EXPECT_TRUE(SpreadDirections(lift, Eigen::Vector3d::UnitZ(), 25.0, 1.0).empty());
+}
+
 }  // namespace
 }  // namespace mbslam

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <sstream>
 
 #include "common/util/logging.h"
 
@@ -47,42 +49,108 @@ int ObjectTracking::PersistentId(int segment_id) {
   return id;
 }
 
+bool ObjectTracking::ConsistentFragment(const ObjectFrame& frame, const ObjectObservation& o,
+                                        const std::vector<const ObjectObservation*>& parts,
+                                        double* distance) const {
+  const double f = std::max(frame.focal_px, 1e-9);
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  Eigen::Vector2d flow = Eigen::Vector2d::Zero();
+  double flow_weight = 0.0;
+  for (const ObjectObservation* p : parts) {
+    for (const Eigen::Vector2d& xy : p->track_xy) {
+      lo = lo.cwiseMin(xy);
+      hi = hi.cwiseMax(xy);
+    }
+    if (p->flow_xy) {
+      flow += static_cast<double>(p->track_xy.size()) * *p->flow_xy;
+      flow_weight += static_cast<double>(p->track_xy.size());
+    }
+  }
+  if (!(lo.array() <= hi.array()).all()) return false;
+  // Distance of the centroid from the object's track box (0 inside).
+  const Eigen::Vector2d c = Centroid(o.track_xy);
+  const Eigen::Vector2d outside = (lo - c).cwiseMax(c - hi).cwiseMax(Eigen::Vector2d::Zero());
+  const double d = outside.norm();
+  if (distance) *distance = d;
+  if (d > options_.fragment_radius_px / f) return false;
+  if (o.flow_xy && flow_weight > 0.0) {
+    flow /= flow_weight;
+    const double diff = (*o.flow_xy - flow).norm();
+    const double scale = std::max(o.flow_xy->norm(), flow.norm());
+    if (diff > std::max(options_.fragment_flow_abs_px / f, options_.fragment_flow_rel * scale)) return false;
+  }
+  return true;
+}
+
 int ObjectTracking::Reidentify(const ObjectFrame& frame, const ObjectObservation& o,
-                               const std::map<int, bool>& taken) const {
-  // Shared tracks first: a split or a re-labelled cluster keeps most of its tracks.
+                               const std::map<int, std::vector<const ObjectObservation*>>& parts,
+                               bool* fragment) const {
+  *fragment = false;
+  // Shared tracks first: a split or a re-labelled cluster keeps most of its tracks, and a
+  // cluster that took most of an object's last tracks (and gained new ones) is that object.
   int best = 0;
-  size_t best_shared = 0;
+  size_t best_shared = 0, best_known = 0;
   for (const auto& [id, s] : objects_) {
-    if (taken.count(id)) continue;
     size_t shared = 0;
     for (int64_t t : o.track_ids) shared += s.last_xy.count(t);
     if (shared > best_shared) {
       best_shared = shared;
+      best_known = s.last_xy.size();
       best = id;
     }
   }
-  if (best != 0 && static_cast<double>(best_shared) >= options_.reid_track_share * o.track_ids.size()) return best;
-  // Else the nearest prediction of an object not seen in this image.
+  if (best != 0 && static_cast<int>(best_shared) >= options_.min_tracks &&
+      static_cast<double>(best_shared) >= options_.reid_track_share * std::min(o.track_ids.size(), best_known)) {
+    auto p = parts.find(best);
+    if (p == parts.end()) return best;  // re-labelled
+    // A split: the object is seen in this image already; the part joins it if it agrees.
+    if (options_.merge_fragments && ConsistentFragment(frame, o, p->second)) {
+      *fragment = true;
+      return best;
+    }
+    return 0;
+  }
+  // Else the nearest prediction of an object not seen in this image: its reference point
+  // within reid_radius_px of the segment's centroid (or of its tracks' box with
+  // reid_near_tracks), the nearest to the centroid.
   const Eigen::Vector2d c = Centroid(o.track_xy);
-  double best_d = options_.reid_radius_px / std::max(frame.focal_px, 1e-9);
+  Eigen::Vector2d lo = o.track_xy.front(), hi = o.track_xy.front();
+  for (const Eigen::Vector2d& xy : o.track_xy) {
+    lo = lo.cwiseMin(xy);
+    hi = hi.cwiseMax(xy);
+  }
+  const double radius = options_.reid_radius_px / std::max(frame.focal_px, 1e-9);
+  double best_d = std::numeric_limits<double>::infinity();
   best = 0;
   for (const auto& [id, s] : objects_) {
-    if (taken.count(id) || !s.filter.initialized()) continue;
-    bool seen_now = false;
-    for (const auto& [seg, link] : object_of_segment_) {
-      if (link.id == id && seg != o.id) {
-        for (const ObjectObservation& other : frame.objects) seen_now |= other.id == seg;
-      }
-    }
-    if (seen_now) continue;
+    if (parts.count(id) || !s.filter.initialized()) continue;
     const Eigen::Vector3d p = frame.cam_from_world * s.filter.Estimate().world_from_object.translation;
     if (p.z() <= 0.0) continue;
-    const double d = (p.head<2>() / p.z() - c).norm();
+    const Eigen::Vector2d q = p.head<2>() / p.z();
+    const double d = (q - c).norm();
+    const double gap = options_.reid_near_tracks ? (lo - q).cwiseMax(q - hi).cwiseMax(Eigen::Vector2d::Zero()).norm() : d;
+    if (gap > radius) continue;
     if (d < best_d) {
       best_d = d;
       best = id;
     }
   }
+  if (best != 0 || !options_.merge_fragments || !options_.merge_new_clusters) return best;
+  // Else a fragment of an object seen in this image: next to its tracks, moving alike, and
+  // not larger than what is seen of it (a larger cluster beside it is another object).
+  best_d = std::numeric_limits<double>::infinity();
+  for (const auto& [id, ps] : parts) {
+    double d = 0.0;
+    size_t tracks = 0;
+    for (const ObjectObservation* q : ps) tracks += q->track_ids.size();
+    if (o.track_ids.size() > tracks || !objects_.count(id) || !ConsistentFragment(frame, o, ps, &d)) continue;
+    if (d < best_d) {
+      best_d = d;
+      best = id;
+    }
+  }
+  *fragment = best != 0;
   return best;
 }
 
@@ -183,18 +251,89 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
   const Eigen::Vector3d up_or_camera =
       up ? *up : Eigen::Vector3d(frame.cam_from_world.Inverse().rotation * Eigen::Vector3d(0, -1, 0));
 
-  std::map<int, bool> seen;  // persistent ids observed in this image
-  for (const ObjectObservation& o : frame.objects) {
-    if (static_cast<int>(o.track_xy.size()) < options_.min_tracks || o.track_xy.size() != o.track_ids.size()) continue;
+  // Association: every segment to a persistent id. Segments already known come first
+  // (largest first), so that a new segment can be recognised as a fragment of them.
+  std::vector<size_t> order;
+  for (size_t k = 0; k < frame.objects.size(); ++k) {
+    const ObjectObservation& o = frame.objects[k];
+    if (!o.track_xy.empty() && o.track_xy.size() == o.track_ids.size()) order.push_back(k);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    const bool ka = object_of_segment_.count(frame.objects[a].id) > 0;
+    const bool kb = object_of_segment_.count(frame.objects[b].id) > 0;
+    if (ka != kb) return ka;
+    return frame.objects[a].track_ids.size() > frame.objects[b].track_ids.size();
+  });
+  std::map<int, std::vector<const ObjectObservation*>> parts;  // persistent id -> its segments now
+  for (size_t k : order) {
+    const ObjectObservation& o = frame.objects[k];
     int id = 0;
     auto known = object_of_segment_.find(o.id);
-    if (known != object_of_segment_.end() && !seen.count(known->second.id)) {
+    if (known != object_of_segment_.end()) {
       id = known->second.id;
-    } else {
-      id = Reidentify(frame, o, seen);
-      if (id != 0) ++stats_.reidentified;
+      auto p = parts.find(id);
+      if (p != parts.end() && !(options_.merge_fragments && ConsistentFragment(frame, o, p->second))) {
+        // This part no longer agrees with the object's others: identified again.
+        ++stats_.fragments_split;
+        MBSLAM_LOG(DEBUG) << "segment " << o.id << ": no longer agrees with object " << id << ", split off";
+        id = 0;
+      }
     }
-    if (id == 0) id = next_id_++;
+    if (id == 0) {
+      bool fragment = false;
+      id = Reidentify(frame, o, parts, &fragment);
+      if (id != 0) {
+        ++(fragment ? stats_.fragments_merged : stats_.reidentified);
+        MBSLAM_LOG(DEBUG) << "segment " << o.id << " (" << o.track_ids.size() << " tracks): "
+                          << (fragment ? "fragment of" : "re-identified as") << " object " << id;
+      }
+    }
+    if (id == 0) {
+      id = next_id_++;
+      if (GetLogLevel() <= LogLevel::kDebug) {
+        std::ostringstream why;
+        const Eigen::Vector2d c = Centroid(o.track_xy) * frame.focal_px;
+        why << "segment " << o.id << " (" << o.track_ids.size() << " tracks at " << c.transpose() << " px, flow "
+            << (o.flow_xy ? Eigen::Vector2d(*o.flow_xy * frame.focal_px) : Eigen::Vector2d::Constant(NAN)).transpose()
+            << "): new object " << id << ";";
+        for (const auto& [oid, st] : objects_) {
+          size_t shared = 0;
+          for (int64_t t : o.track_ids) shared += st.last_xy.count(t);
+          double pred = NAN;
+          if (st.filter.initialized()) {
+            const Eigen::Vector3d p = frame.cam_from_world * st.filter.Estimate().world_from_object.translation;
+            if (p.z() > 0.0) pred = (p.head<2>() / p.z() * frame.focal_px - c).norm();
+          }
+          double frag = NAN;
+          auto pp = parts.find(oid);
+          if (pp != parts.end()) ConsistentFragment(frame, o, pp->second, &frag);
+          why << " [" << oid << (pp != parts.end() ? " seen" : "") << " shared " << shared << " pred " << pred
+              << " px box " << frag * frame.focal_px << " px unseen " << (frame.utime - st.last_seen_utime) / 1000 << " ms]";
+        }
+        MBSLAM_LOG(DEBUG) << why.str();
+      }
+    }
+    object_of_segment_[o.id] = SegmentLink{id, frame.utime};
+    parts[id].push_back(&o);
+  }
+
+  std::map<int, bool> seen;  // persistent ids observed in this image
+  for (const auto& [id, ps] : parts) {
+    // One observation of the object from all its parts (the largest part first).
+    ObjectObservation o = *ps.front();
+    for (size_t k = 1; k < ps.size(); ++k) {
+      const ObjectObservation& q = *ps[k];
+      o.track_ids.insert(o.track_ids.end(), q.track_ids.begin(), q.track_ids.end());
+      o.track_xy.insert(o.track_xy.end(), q.track_xy.begin(), q.track_xy.end());
+      o.mapped_points.insert(o.mapped_points.end(), q.mapped_points.begin(), q.mapped_points.end());
+      if (q.background_depth) {
+        // The looser bound of the parts (each is the static depth behind its centroid).
+        if (!o.background_depth || q.background_depth->max > o.background_depth->max) {
+          o.background_depth = q.background_depth;
+        }
+      }
+    }
+    if (static_cast<int>(o.track_xy.size()) < options_.min_tracks) continue;
     auto it = objects_.find(id);
     if (it == objects_.end()) {
       const double m = MetresPerUnit(frame);
@@ -203,7 +342,6 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
                .first;
       it->second.metres_per_unit = m;
     }
-    object_of_segment_[o.id] = SegmentLink{id, frame.utime};
     State& s = it->second;
     s.segment_id = o.id;
     bool restarted = false;

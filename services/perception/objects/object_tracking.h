@@ -29,8 +29,16 @@
 // re-detected under a new id after a few images without tracks). A new segment id is
 // taken to be an object already tracked when most of its tracks belonged to that object,
 // or else when its centroid lies within `reid_radius_px` of where that object's filter
-// predicts its reference point and the object was not seen in this image. Outputs carry
-// the persistent id; `segment_id` maps back to the segmentation's labels.
+// predicts its reference point and the object was not seen in this image. "Most of its
+// tracks" is counted against the smaller of the segment and the object's last track set
+// (a cluster that took an object's tracks and gained new ones is still that object). A
+// segment whose tracks belonged to an object that is also seen in this image (a split) is
+// a fragment of it when it lies next to the object's other tracks and moves like them
+// (with merge_new_clusters also a cluster of new tracks that does). Several segments of
+// one object are one observation (their tracks merged) for one filter; a part that stops
+// agreeing with the others (far from them, or moving differently) is split off and
+// identified again. Outputs carry the persistent id;
+// `segment_id` is the largest part's segmentation id, PersistentId() maps every segment.
 //
 // Algorithm layer: no LCM, no threads; deterministic (the filters are seeded by object id).
 
@@ -74,6 +82,16 @@ struct ObjectTrackingOptions {
   double reference_centroid_pull = 0.05;
   double reid_track_share = 0.5;        // a new segment with this share of an object's tracks is it
   double reid_radius_px = 40.0;         // ... or with its centroid this near the predicted point (px)
+  bool reid_near_tracks = false;        // ... measured to the segment's track box, not its centroid
+  // Fragments: a segment that is part of an object also seen in this image (the
+  // segmentation split it, or clustered new tracks on it apart) joins that object's
+  // filter when its centroid lies this near the object's tracks and its image motion
+  // agrees; a part that stops agreeing is split off again.
+  bool merge_fragments = true;
+  bool merge_new_clusters = false;      // ... also clusters of new tracks (none shared with the object)
+  double fragment_radius_px = 30.0;     // centroid at most this far outside the object's track box (px)
+  double fragment_flow_abs_px = 1.5;    // image motion difference always accepted (px per image)
+  double fragment_flow_rel = 0.35;      // ... or this share of the larger image motion
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(filter);
@@ -88,6 +106,9 @@ struct ObjectTrackingOptions {
     MBSLAM_CHECK_OPTION(reference_centroid_pull >= 0.0 && reference_centroid_pull < 1.0);
     MBSLAM_CHECK_OPTION(reid_track_share > 0.0 && reid_track_share <= 1.0);
     MBSLAM_CHECK_OPTION_GE(reid_radius_px, 0.0);
+    MBSLAM_CHECK_OPTION_GE(fragment_radius_px, 0.0);
+    MBSLAM_CHECK_OPTION_GE(fragment_flow_abs_px, 0.0);
+    MBSLAM_CHECK_OPTION_GE(fragment_flow_rel, 0.0);
     return true;
   }
   template <typename V>
@@ -112,6 +133,15 @@ struct ObjectTrackingOptions {
     v("reid_track_share", &reid_track_share, "a new segment holding this share of an object's tracks is that object");
     v("reid_radius_px", &reid_radius_px,
       "... or a new segment whose centroid is this near an unseen object's predicted point (px)");
+    v("reid_near_tracks", &reid_near_tracks,
+      "... measured to the segment's track box instead of its centroid (large objects)");
+    v("merge_fragments", &merge_fragments,
+      "a segment that is a fragment of an object seen in this image joins its filter");
+    v("merge_new_clusters", &merge_new_clusters,
+      "... also a cluster of new tracks beside the object (no tracks shared with it)");
+    v("fragment_radius_px", &fragment_radius_px, "fragment centroid at most this far outside the object's track box (px)");
+    v("fragment_flow_abs_px", &fragment_flow_abs_px, "fragment image motion difference always accepted (px per image)");
+    v("fragment_flow_rel", &fragment_flow_rel, "... or this share of the larger image motion");
   }
 };
 
@@ -126,6 +156,8 @@ struct ObjectObservation {
   // Mapped positions (world, map units) of its tracks that were static map points: a
   // previously static object (sec. 5.1.2).
   std::vector<Eigen::Vector3d> mapped_points;
+  // Mean image motion of its tracks per image (normalised); unset = unknown.
+  std::optional<Eigen::Vector2d> flow_xy;
 };
 
 struct ObjectFrame {
@@ -160,6 +192,8 @@ struct ObjectTrackingStats {
   int64_t reference_restarts = 0;   // no track carried over: reference back at the centroid
   int64_t reidentified = 0;         // new segment ids recognised as objects already tracked
   int64_t segment_ids_forgotten = 0;  // segment id -> object id links unused for forget_after_us
+  int64_t fragments_merged = 0;     // segments joined to an object seen in the same image
+  int64_t fragments_split = 0;      // parts of an object that stopped agreeing with it
 };
 
 class ObjectTracking {
@@ -195,7 +229,14 @@ class ObjectTracking {
   ObjectExtentOptions ExtentOptionsInUnits(double metres_per_unit) const;
   Eigen::Vector2d MoveReference(State* s, const ObjectObservation& o, bool* restarted) const;
   // The persistent object id of a segment id seen for the first time, or 0 for a new object.
-  int Reidentify(const ObjectFrame& frame, const ObjectObservation& o, const std::map<int, bool>& taken) const;
+  // `parts`: the observations already given to each object in this image; `*fragment` is
+  // set when the segment joins one of those objects.
+  int Reidentify(const ObjectFrame& frame, const ObjectObservation& o,
+                 const std::map<int, std::vector<const ObjectObservation*>>& parts, bool* fragment) const;
+  // True when `o` agrees with the object's other parts in this image: near their tracks
+  // and moving alike (see fragment_radius_px).
+  bool ConsistentFragment(const ObjectFrame& frame, const ObjectObservation& o,
+                          const std::vector<const ObjectObservation*>& parts, double* distance = nullptr) const;
 
   ObjectTrackingOptions options_;
   std::map<int, State> objects_;       // by persistent id

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "services/perception/objects/bot_simulation.h"
@@ -203,6 +204,138 @@ TEST(ObjectTracking, NewSegmentFarAwayIsANewObject) {
   ASSERT_EQ(out.size(), 2u);
   EXPECT_NE(out[0].id, out[1].id);
   EXPECT_EQ(tracking.stats().reidentified, 0);
+}
+
+// Splits the object's observation in frame i into two segments: tracks with even index
+// keep `a`, odd ones go to `b` (flows set when given).
+void SplitInto(ObjectFrame* f, int a, int b, std::optional<Eigen::Vector2d> flow_a = std::nullopt,
+               std::optional<Eigen::Vector2d> flow_b = std::nullopt) {
+  ASSERT_EQ(f->objects.size(), 1u);
+  const ObjectObservation whole = f->objects[0];
+  ObjectObservation pa, pb;
+  pa.id = a;
+  pb.id = b;
+  for (size_t k = 0; k < whole.track_xy.size(); ++k) {
+    ObjectObservation& p = k % 2 == 0 ? pa : pb;
+    p.track_ids.push_back(whole.track_ids[k]);
+    p.track_xy.push_back(whole.track_xy[k]);
+  }
+  pa.background_depth = pb.background_depth = whole.background_depth;
+  pa.flow_xy = flow_a;
+  pb.flow_xy = flow_b;
+  f->objects = {pa, pb};
+}
+
+TEST(ObjectTracking, SplitObjectKeepsOneIdAndOneFilter) {
+  const BotSimSequence seq = Sequence(BotSimCamera::kCar, BotSimTarget::kCrossing);
+  ObjectTracking tracking{ObjectTrackingOptions()};
+  TrackIds ids;
+  int first_id = 0;
+  for (size_t i = 0; i < seq.frames.size(); ++i) {
+    ObjectFrame f = FrameOf(seq, i, 7, &ids);
+    // From a third of the way on, the segmentation splits the object into two clusters.
+    if (i >= seq.frames.size() / 3 && f.objects.size() == 1) SplitInto(&f, 7, 9);
+    const std::vector<TrackedObject>& out = tracking.Update(f);
+    if (!seq.frames[i].visible) continue;
+    ASSERT_EQ(out.size(), 1u) << "frame " << i;
+    if (first_id == 0) first_id = out[0].id;
+    EXPECT_EQ(out[0].id, first_id) << "frame " << i;
+    EXPECT_TRUE(out[0].seen);
+  }
+  EXPECT_EQ(tracking.stats().filters_started, 1);
+  EXPECT_EQ(tracking.stats().fragments_merged, 1);
+  EXPECT_EQ(tracking.PersistentId(9), first_id);
+  EXPECT_EQ(tracking.PersistentId(7), first_id);
+}
+
+TEST(ObjectTracking, FragmentMovingDifferentlyIsSplitOff) {
+  const BotSimSequence seq = Sequence(BotSimCamera::kCar, BotSimTarget::kCrossing);
+  ObjectTracking tracking{ObjectTrackingOptions()};
+  TrackIds ids;
+  const Eigen::Vector2d flow(0.004, 0.0);  // 2 px per image at f = 500
+  size_t i = 0;
+  for (; i < 20; ++i) {
+    ObjectFrame f = FrameOf(seq, i, 7, &ids);
+    if (i >= 10) SplitInto(&f, 7, 9, flow, flow);
+    tracking.Update(f);
+  }
+  ASSERT_EQ(tracking.PersistentId(9), tracking.PersistentId(7));
+  EXPECT_EQ(tracking.stats().fragments_merged, 1);
+  // Segment 9 now moves the other way: a different object after all.
+  ObjectFrame f = FrameOf(seq, i, 7, &ids);
+  SplitInto(&f, 7, 9, flow, -flow);
+  const std::vector<TrackedObject>& out = tracking.Update(f);
+  EXPECT_EQ(tracking.stats().fragments_split, 1);
+  EXPECT_NE(tracking.PersistentId(9), tracking.PersistentId(7));
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NE(out[0].id, out[1].id);
+}
+
+TEST(ObjectTracking, NewClusterOnATrackedObjectJoinsIt) {
+  const BotSimSequence seq = Sequence(BotSimCamera::kCar, BotSimTarget::kCrossing);
+  const Eigen::Vector2d flow(0.004, 0.001);
+  for (const bool same_motion : {true, false}) {
+    ObjectTrackingOptions options;
+    options.merge_new_clusters = true;
+    ObjectTracking tracking(options);
+    TrackIds ids;
+    size_t i = 0;
+    for (; i < 20; ++i) {
+      ObjectFrame f = FrameOf(seq, i, 7, &ids);
+      f.objects[0].flow_xy = flow;
+      tracking.Update(f);
+    }
+    // New tracks on the object (ids never seen) clustered apart by the segmentation.
+    ObjectFrame f = FrameOf(seq, i, 7, &ids);
+    f.objects[0].flow_xy = flow;
+    ObjectObservation extra;
+    extra.id = 11;
+    const Eigen::Vector2d c = f.objects[0].track_xy.front();
+    for (int k = 0; k < 6; ++k) {
+      extra.track_ids.push_back(5000 + k);
+      extra.track_xy.push_back(c + Eigen::Vector2d(0.002 * k, 0.001 * (k % 3)));
+    }
+    extra.flow_xy = same_motion ? Eigen::Vector2d(flow) : Eigen::Vector2d(-flow);
+    f.objects.push_back(extra);
+    const std::vector<TrackedObject>& out = tracking.Update(f);
+    if (same_motion) {
+      ASSERT_EQ(out.size(), 1u);
+      EXPECT_EQ(tracking.PersistentId(11), tracking.PersistentId(7));
+      EXPECT_EQ(tracking.stats().fragments_merged, 1);
+      EXPECT_EQ(tracking.stats().filters_started, 1);
+    } else {
+      ASSERT_EQ(out.size(), 2u);
+      EXPECT_NE(tracking.PersistentId(11), tracking.PersistentId(7));
+      EXPECT_EQ(tracking.stats().fragments_merged, 0);
+    }
+  }
+}
+
+// The segmentation re-labels the object and the new cluster also took many new tracks:
+// it holds all of the object's last tracks, though they are a minority of its own.
+TEST(ObjectTracking, ClusterHoldingAnObjectsTracksIsThatObject) {
+  const BotSimSequence seq = Sequence(BotSimCamera::kCar, BotSimTarget::kCrossing);
+  ObjectTracking tracking{ObjectTrackingOptions()};
+  TrackIds ids;
+  size_t i = 0;
+  for (; i < 20; ++i) tracking.Update(FrameOf(seq, i, 7, &ids));
+  ASSERT_EQ(tracking.size(), 1u);
+  const int id = tracking.PersistentId(7);
+  ObjectFrame f = FrameOf(seq, i, 7, &ids);
+  ObjectObservation& o = f.objects[0];
+  o.id = 12;
+  const size_t n = o.track_ids.size();
+  ASSERT_GE(n, 3u);
+  for (size_t k = 0; k < 3 * n; ++k) {  // new tracks around the old ones
+    o.track_ids.push_back(7000 + static_cast<int64_t>(k));
+    o.track_xy.push_back(o.track_xy[k % n] + Eigen::Vector2d(0.002, 0.001 * static_cast<double>(k % 5)));
+  }
+  const std::vector<TrackedObject>& out = tracking.Update(f);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].id, id);
+  EXPECT_EQ(tracking.PersistentId(12), id);
+  EXPECT_EQ(tracking.stats().reidentified, 1);
+  EXPECT_EQ(tracking.stats().filters_started, 1);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "common/util/logging.h"
+#include "services/perception/geometry/polygon.h"
 
 namespace mbslam {
 
@@ -164,12 +165,33 @@ void PerceptionCore::UpdateGroundPlane() {
   const Rigid3d& first = map.keyframes().begin()->second.cam_from_world;
   const Eigen::Vector3d up = -(first.RotationMatrix().transpose() * Eigen::Vector3d::UnitY());
   GroundPlaneEstimate estimate;
-  if (EstimateGroundPlane(points, up, options_.ground, &estimate).ok() &&
-      estimate.inlier_ratio >= options_.ground_min_support) {
-    ground_ = estimate.plane;
-    MBSLAM_LOG(DEBUG) << "ground plane: n " << estimate.plane.normal.transpose() << " d " << estimate.plane.offset
-                      << ", inliers " << estimate.num_inliers << " (" << estimate.inlier_ratio << "), rms " << estimate.rms;
+  if (!EstimateGroundPlane(points, up, options_.ground, &estimate).ok() ||
+      estimate.inlier_ratio < options_.ground_min_support) {
+    return;
   }
+  const Eigen::Vector3d camera = map.LastKeyframe()->cam_from_world.Inverse().translation;
+  bool along_path = false;
+  if (options_.objects.camera_height_m > 0.0 && options_.ground.path_parallel_min_spread > 0.0) {
+    // The camera rides at a constant height: its travel lies in a plane parallel to the
+    // ground. A small tilt of a plane fitted to distant points alone would make the
+    // camera's height above it (and the metres per unit, the ground cues) drift as it moves.
+    const double h = estimate.plane.Height(camera);
+    std::vector<Eigen::Vector3d> centres;
+    for (const auto& [id, k] : map.keyframes()) centres.push_back(k.cam_from_world.Inverse().translation);
+    const std::vector<Eigen::Vector3d> directions = SpreadDirections(
+        centres, estimate.plane.normal, options_.ground.max_tilt_deg, options_.ground.path_parallel_min_spread * h);
+    GroundPlaneEstimate constrained;
+    if (h > 0.0 && !directions.empty() &&
+        EstimateGroundPlane(points, up, options_.ground, directions, &constrained).ok() &&
+        constrained.inlier_ratio >= options_.ground_min_support) {
+      estimate = constrained;
+      along_path = true;
+    }
+  }
+  ground_ = estimate.plane;
+  MBSLAM_LOG(DEBUG) << "ground plane: n " << estimate.plane.normal.transpose() << " d " << estimate.plane.offset
+                    << ", inliers " << estimate.num_inliers << " (" << estimate.inlier_ratio << "), rms " << estimate.rms
+                    << ", camera height " << estimate.plane.Height(camera) << (along_path ? ", parallel to the path" : "");
 }
 
 DepthBound PerceptionCore::DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const {
@@ -519,6 +541,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
         const double f = map_update.rescaled_by ? *map_update.rescaled_by : 1.0;
         ob.background_depth = DepthRange{0.0, b.z_max * f};
       }
+      if (o.mean_flow_px.allFinite()) ob.flow_xy = o.mean_flow_px / of.focal_px;
       auto mp = mapped_points_of.find(o.id);
       if (mp != mapped_points_of.end()) {
         ob.mapped_points = mp->second;
@@ -532,19 +555,10 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     for (const TrackedObject& t : *tracked) tracked_of[t.id] = &t;
   }
   // Segmentation ids -> persistent object ids (the filters keep an object's identity when
-  // the segmentation re-labels it).
+  // the segmentation re-labels it, and several segments of one object share its id).
   std::map<int, int> object_id_of;
-  std::map<int, const TrackedObject*> tracked_of_segment;
-  if (tracked) {
-    for (const TrackedObject& t : *tracked) {
-      if (t.seen) tracked_of_segment[t.segment_id] = &t;
-    }
-  }
   for (const SegmentedObject& o : seg.objects) {
-    auto t = tracked_of_segment.find(o.id);
-    object_id_of[o.id] = t != tracked_of_segment.end() ? t->second->id
-                         : options_.objects.enabled   ? object_tracking_.PersistentId(o.id)
-                                                      : o.id;
+    object_id_of[o.id] = options_.objects.enabled ? object_tracking_.PersistentId(o.id) : o.id;
   }
 
   // Person checks run on the other core, one image behind: the checks launched with the
@@ -577,33 +591,48 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     }
   }
 
-  // Moving objects: hulls, person check, occluders for the next image.
+  // Moving objects: hulls, person check, occluders for the next image. One output per
+  // persistent id: the segments of one object (fragments) share its hull.
   occluders_.clear();
+  std::map<int, std::vector<const SegmentedObject*>> segments_of;
+  std::vector<int> object_order;  // first appearance in the segmentation's order
   for (const SegmentedObject& o : seg.objects) {
     const int oid = object_id_of[o.id];
+    if (!segments_of.count(oid)) object_order.push_back(oid);
+    segments_of[oid].push_back(&o);
+    TrackingHints::Hull occ;
+    occ.body_id = o.id;
+    for (const Eigen::Vector2d& p : o.hull) occ.points.push_back((p + o.mean_flow_px).cast<float>());
+    if (occ.points.size() >= 3) occluders_.push_back(std::move(occ));
+  }
+  for (const int oid : object_order) {
+    const std::vector<const SegmentedObject*>& parts = segments_of[oid];
     ObjectOutput out;
     out.id = oid;
     out.state = ObjectState::kDetected;
     auto tr = tracked_of.find(oid);
-    if (tr != tracked_of.end() && tr->second->seen) {
+    if (tr != tracked_of.end()) {
+      // Seen, or segmented with too few tracks for its filter in this image: the estimate
+      // (predicted when not seen).
       FillObjectEstimate(*tr->second, &out);
       tracked_of.erase(tr);
     }
     ObjectRecord& record = RecordOf(oid, frame.utime);
     out.first_seen_utime = record.first_utime;
-    out.num_tracks = static_cast<int>(o.track_ids.size());
     HullOutput hull;
     hull.body_id = oid;
-    TrackingHints::Hull occ;
-    occ.body_id = o.id;
+    std::vector<Eigen::Vector2f> points;
+    for (const SegmentedObject* o : parts) {
+      out.num_tracks += static_cast<int>(o->track_ids.size());
+      for (const Eigen::Vector2d& p : o->hull) points.push_back(p.cast<float>());
+    }
+    hull.points = parts.size() == 1 ? points : ConvexHull(points);
     float min_x = 1e9f, min_y = 1e9f, max_x = -1e9f, max_y = -1e9f;
-    for (const Eigen::Vector2d& p : o.hull) {
-      hull.points.push_back(p.cast<float>());
-      occ.points.push_back((p + o.mean_flow_px).cast<float>());
-      min_x = std::min(min_x, static_cast<float>(p.x()));
-      min_y = std::min(min_y, static_cast<float>(p.y()));
-      max_x = std::max(max_x, static_cast<float>(p.x()));
-      max_y = std::max(max_y, static_cast<float>(p.y()));
+    for (const Eigen::Vector2f& p : hull.points) {
+      min_x = std::min(min_x, p.x());
+      min_y = std::min(min_y, p.y());
+      max_x = std::max(max_x, p.x());
+      max_y = std::max(max_y, p.y());
     }
     if (person_check_due.count(oid) && hull.points.size() >= 3) {
       person_boxes.emplace_back(oid, cv::Rect(static_cast<int>(min_x), static_cast<int>(min_y),
@@ -613,7 +642,6 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     out.object_class = record.is_person ? ObjectClass::kPerson : ObjectClass::kUnknown;
     out.hull = hull;
     result.hulls.push_back(hull);
-    if (occ.points.size() >= 3) occluders_.push_back(std::move(occ));
     result.objects.push_back(std::move(out));
   }
   // Objects not segmented in this image (occluded, left the view) but recently seen: the
