@@ -7,12 +7,14 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <unordered_set>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
 #include "common/util/logging.h"
 #include "services/perception/geometry/polygon.h"
+#include "services/perception/slam/init_selection.h"
 #include "services/perception/slam/triangulation.h"
 #include "services/perception/tracking/patch_matcher.h"
 
@@ -20,6 +22,9 @@ namespace mbslam {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
+// Grid of the initialisation's coverage test (cells across, down).
+constexpr int kInitGridCols = 8;
+constexpr int kInitGridRows = 6;
 
 double Median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -340,13 +345,75 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   }
   if (Median(disp) < 8.0) return;  // not enough motion yet
 
+  const double thresh = 1.0 / frame.focal_px;
+  std::unordered_set<int64_t> other_motion;  // members of the motions not chosen (kept out of the map)
+  // The static world is the motion that spans the image, not the one with most inliers
+  // (a large moving object the camera follows would win a plain RANSAC), and not one
+  // inside moving-object hulls.
+  if (options_.init_max_motions > 1 || options_.init_min_coverage > 0.0 || options_.init_max_hull_share < 1.0) {
+    std::vector<Eigen::Vector2d> all_xy;
+    all_xy.reserve(frame.observations.size());
+    for (const SlamObservation& o : frame.observations) all_xy.push_back(o.xy);
+    std::vector<InitMotionGroup> groups =
+        FindMotionGroups(xr, xn, thresh, options_.init_min_points, options_.init_max_motions);
+    ScoreMotionGroups(xn, all_xy, frame.moving_hulls_xy, kInitGridCols, kInitGridRows, &groups);
+    const int g = SelectStaticGroup(groups, options_.init_min_coverage, options_.init_max_hull_share);
+    if (GetLogLevel() <= LogLevel::kDebug) {
+      for (size_t k = 0; k < groups.size(); ++k) {
+        MBSLAM_LOG(DEBUG) << "SLAM init frame " << frame.frame_index << ": motion " << k << " of " << ids.size()
+                          << " tracks: " << groups[k].count << " inliers, coverage " << groups[k].coverage
+                          << ", in hulls " << groups[k].hull_share;
+      }
+    }
+    if (g < 0) {
+      // The tracks shared with the reference no longer span the image (the background
+      // left the view, or only an object was tracked): start again from this image.
+      std::vector<InitMotionGroup> all(1);
+      all[0].inliers.assign(ids.size(), 1);
+      all[0].count = static_cast<int>(ids.size());
+      ScoreMotionGroups(xn, all_xy, {}, kInitGridCols, kInitGridRows, &all);
+      MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": no broad static motion among "
+                        << groups.size() << " (largest: " << (groups.empty() ? 0 : groups[0].count)
+                        << " inliers, coverage " << (groups.empty() ? 0.0 : groups[0].coverage) << ", in hulls "
+                        << (groups.empty() ? 0.0 : groups[0].hull_share) << "); shared tracks cover "
+                        << all[0].coverage;
+      if (all[0].coverage < options_.init_min_coverage) set_reference();
+      out->state = state_;
+      return;
+    }
+    // When the largest motion is the static world (the usual case) the two-view estimate
+    // below runs on all tracks as before. Otherwise only the chosen motion's tracks enter
+    // the map, and the other motions' tracks are kept out of both views.
+    if (g > 0) {
+      const InitMotionGroup& chosen = groups[static_cast<size_t>(g)];
+      MBSLAM_LOG(INFO) << "SLAM init at frame " << frame.frame_index << ": motion " << g << " (" << chosen.count
+                       << " inliers, coverage " << chosen.coverage << ") is the static world, not the largest ("
+                       << groups[0].count << " inliers, coverage " << groups[0].coverage << ")";
+      std::vector<int64_t> ids_g;
+      std::vector<Eigen::Vector2d> xr_g, xn_g;
+      for (size_t i = 0; i < ids.size(); ++i) {
+        if (chosen.inliers[i]) {
+          ids_g.push_back(ids[i]);
+          xr_g.push_back(xr[i]);
+          xn_g.push_back(xn[i]);
+        } else {
+          for (const InitMotionGroup& other : groups) {
+            if (other.inliers[i]) other_motion.insert(ids[i]);
+          }
+        }
+      }
+      ids = std::move(ids_g);
+      xr = std::move(xr_g);
+      xn = std::move(xn_g);
+    }
+  }
+
   const size_t n = ids.size();
   std::vector<cv::Point2d> pr(n), pn(n);
   for (size_t i = 0; i < n; ++i) {
     pr[i] = cv::Point2d(xr[i].x(), xr[i].y());
     pn[i] = cv::Point2d(xn[i].x(), xn[i].y());
   }
-  const double thresh = 1.0 / frame.focal_px;
   cv::Mat e_mask, h_mask;
   cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, e_mask);
   cv::Mat H = cv::findHomography(pr, pn, cv::RANSAC, 1.5 * thresh, h_mask, 2000, 0.999);
@@ -420,6 +487,27 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
                       << (best ? best->median_parallax / kDeg : 0.0) << " deg";
     return;  // refuse for now; more parallax will come (or the reference is replaced)
   }
+  // The points that would make the map (those with parallax) must span the image too:
+  // when the background only rotates, a followed object is all that has parallax.
+  double map_coverage = 1.0;
+  if (options_.init_min_coverage > 0.0 || options_.init_max_hull_share < 1.0) {
+    std::vector<Eigen::Vector2d> all_xy;
+    all_xy.reserve(frame.observations.size());
+    for (const SlamObservation& o : frame.observations) all_xy.push_back(o.xy);
+    std::vector<InitMotionGroup> mapped(1);
+    mapped[0].inliers.assign(n, 0);
+    for (const auto& [i, X] : best->points) mapped[0].inliers[i] = 1;
+    mapped[0].count = static_cast<int>(best->points.size());
+    ScoreMotionGroups(xn, all_xy, frame.moving_hulls_xy, kInitGridCols, kInitGridRows, &mapped,
+                      /*require_majority=*/false);
+    map_coverage = mapped[0].coverage;
+    if (SelectStaticGroup(mapped, options_.init_min_coverage, options_.init_max_hull_share) < 0) {
+      MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": the " << best->points.size()
+                        << " points with parallax cover " << map_coverage << " of the image, "
+                        << mapped[0].hull_share << " inside moving hulls";
+      return;
+    }
+  }
 
   // Build the map: keyframe 0 at the reference (fixed gauge), keyframe 1 here.
   map_.Clear();
@@ -444,6 +532,10 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   k0.cam_from_world = Rigid3d();
   k0.fixed = true;
   k0.track_xy = init_ref_xy_;
+  for (int64_t id : other_motion) {
+    k0.track_xy.erase(id);
+    current.erase(id);
+  }
   if (init_ref_odom_) {
     k0.has_odometry = true;
     k0.odom_from_cam = *init_ref_odom_;
@@ -498,7 +590,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   confirm_count_ = 0;
   MBSLAM_LOG(INFO) << "SLAM: initialised from frames " << init_ref_frame_ << "-" << frame.frame_index << " with "
                    << map_.num_points() << " points (" << (planar ? "homography" : "essential")
-                   << ", median parallax " << best->median_parallax / kDeg << " deg"
+                   << ", median parallax " << best->median_parallax / kDeg << " deg, coverage " << map_coverage
                    << (metric_ ? ", metric scale from odometry" : "") << ")";
   out->state = state_;
   out->valid = state_ == SlamState::kTracking;

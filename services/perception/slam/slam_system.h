@@ -9,8 +9,11 @@
 //   UpdateMap()   after segmentation: moving tracks leave the map, keyframes,
 //                 triangulation, culling, local bundle adjustment (inline, or in a
 //                 back-end thread whose result is merged at the next image).
-// Initialisation: two views with enough parallax, essential matrix (5-point RANSAC)
-// against a homography (model selection), refusal on too little parallax, and a
+// Initialisation: two views with enough parallax; the static world is the motion that
+// spans the image (sequential RANSAC into motions, the broadest chosen, not the largest;
+// none inside moving hulls), and its points with parallax must span the image too (a
+// followed object is not a map); essential matrix (5-point RANSAC) against a homography
+// (model selection), refusal on too little parallax, and a
 // confirmation by the following views (the 3-view check of sec. 4.4) before the map is
 // trusted; failures retry automatically. With odometry the map is metric.
 
@@ -49,6 +52,9 @@ struct SlamOptions {
   int init_min_points = 50;              // triangulated points needed (count)
   int init_max_frames = 90;              // the reference view is replaced after this (frames)
   double init_homography_ratio = 0.95;   // H inliers / E inliers above this = planar / low parallax: use H or refuse
+  int init_max_motions = 3;              // motions told apart in the two views (sequential RANSAC) (count)
+  double init_min_coverage = 0.3;        // the static world's inliers, and its points with parallax, must hold this share of the image's feature cells
+  double init_max_hull_share = 0.5;      // an initialisation with more of its inliers inside moving hulls is refused
   int init_confirm_frames = 3;           // frames the new map must track well before it is trusted (frames)
   double init_confirm_inlier_ratio = 0.7;  // inlier share required while confirming
   double triangulation_min_angle_deg = 1.0;  // new points need this parallax (deg)
@@ -85,6 +91,9 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION_GE(init_min_points, 8);
     MBSLAM_CHECK_OPTION_GT(init_max_frames, 1);
     MBSLAM_CHECK_OPTION(init_homography_ratio > 0.0 && init_homography_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(init_max_motions, 1);
+    MBSLAM_CHECK_OPTION(init_min_coverage >= 0.0 && init_min_coverage <= 1.0);
+    MBSLAM_CHECK_OPTION(init_max_hull_share >= 0.0 && init_max_hull_share <= 1.0);
     MBSLAM_CHECK_OPTION_GE(init_confirm_frames, 0);
     MBSLAM_CHECK_OPTION(init_confirm_inlier_ratio > 0.0 && init_confirm_inlier_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GT(triangulation_min_angle_deg, 0.0);
@@ -112,6 +121,9 @@ struct SlamOptions {
     v("init_min_points", &init_min_points, "triangulated points needed (count)");
     v("init_max_frames", &init_max_frames, "reference view replaced after (frames)");
     v("init_homography_ratio", &init_homography_ratio, "H/E inlier ratio meaning planar or low parallax");
+    v("init_max_motions", &init_max_motions, "motions told apart at initialisation, the broadest is the static world (count)");
+    v("init_min_coverage", &init_min_coverage, "image feature cells the static world's inliers and its points with parallax must hold (share)");
+    v("init_max_hull_share", &init_max_hull_share, "inliers inside moving hulls above this share: initialisation refused");
     v("init_confirm_frames", &init_confirm_frames, "frames a new map must track well (frames)");
     v("init_confirm_inlier_ratio", &init_confirm_inlier_ratio, "inlier share while confirming");
     v("triangulation_min_angle_deg", &triangulation_min_angle_deg, "parallax of new points (deg)");
