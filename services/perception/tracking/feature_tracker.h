@@ -33,6 +33,7 @@ struct TrackerOptions {
   int klt_levels = 3;                  // pyramid levels used by KLT (count)
   int klt_backward_levels = 3;         // levels of the backward (consistency) pass; fewer are faster but let more false matches through (count)
   int klt_max_iterations = 12;         // KLT iterations per level (count)
+  int klt_threads = 2;                 // KLT points split over this many threads (identical result; count)
   double klt_epsilon = 0.05;           // KLT convergence (px)
   double max_forward_backward_px = 0.8;  // forward-backward consistency (px)
   double unicity_px = 1.2;             // two tracks closer than this keep only the better (px)
@@ -62,6 +63,7 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION_GE(klt_levels, 1);
     MBSLAM_CHECK_OPTION(klt_backward_levels >= 1 && klt_backward_levels <= klt_levels);
     MBSLAM_CHECK_OPTION_GT(klt_max_iterations, 0);
+    MBSLAM_CHECK_OPTION(klt_threads >= 1 && klt_threads <= 16);
     MBSLAM_CHECK_OPTION_GT(klt_epsilon, 0.0);
     MBSLAM_CHECK_OPTION_GT(max_forward_backward_px, 0.0);
     MBSLAM_CHECK_OPTION_GE(unicity_px, 0.0);
@@ -91,6 +93,7 @@ struct TrackerOptions {
     v("border_px", &border_px, "image border without features (px)");
     v("klt_window_px", &klt_window_px, "KLT window side (px)");
     v("klt_levels", &klt_levels, "KLT pyramid levels (count)");
+    v("klt_threads", &klt_threads, "KLT points split over this many threads, identical result (count)");
     v("klt_backward_levels", &klt_backward_levels, "levels of the backward consistency pass, which starts at the answer (count)");
     v("klt_max_iterations", &klt_max_iterations, "KLT iterations per level (count)");
     v("klt_epsilon", &klt_epsilon, "KLT convergence (px)");
