@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <future>
 
 #include <opencv2/features2d.hpp>
@@ -26,6 +28,21 @@ namespace {
 bool InBorder(const Eigen::Vector2f& uv, const cv::Mat& image, float border) {
   return uv.x() >= border && uv.y() >= border && uv.x() <= image.cols - 1 - border &&
          uv.y() <= image.rows - 1 - border;
+}
+
+// Hamming distance of two binary descriptors of `bytes` bytes (as cv::NORM_HAMMING, without
+// a Mat header per pair: the fallback compares hundreds of thousands of pairs).
+int HammingDistance(const uint8_t* a, const uint8_t* b, int bytes) {
+  int d = 0;
+  int k = 0;
+  for (; k + 8 <= bytes; k += 8) {
+    uint64_t x, y;
+    std::memcpy(&x, a + k, 8);
+    std::memcpy(&y, b + k, 8);
+    d += __builtin_popcountll(x ^ y);
+  }
+  for (; k < bytes; ++k) d += __builtin_popcount(static_cast<unsigned>(a[k] ^ b[k]));
+  return d;
 }
 
 // Pyramidal KLT (OPTFLOW_USE_INITIAL_FLOW: `next` holds the initial guesses). Every
@@ -298,7 +315,8 @@ void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat
     for (size_t j = 0; j < kps.size(); ++j) {
       const cv::Point2f d = kps[j].pt - prev_kps[i].pt;
       if (d.dot(d) > radius * radius) continue;
-      const int dist = cv::norm(prev_desc.row(static_cast<int>(i)), desc.row(static_cast<int>(j)), cv::NORM_HAMMING);
+      const int dist = HammingDistance(prev_desc.ptr<uint8_t>(static_cast<int>(i)),
+                                       desc.ptr<uint8_t>(static_cast<int>(j)), desc.cols);
       if (dist < b1) {
         b2 = b1;
         b1 = dist;
