@@ -2,6 +2,7 @@
 # Speed: perception_service live (realtime) at 640x480 fed at 30 Hz and 60 Hz through lcm-logplayer over udpm:// in a private netns; fps, latency and per-stage p50 / p99, peak RSS; sim-multi and a real sequence
 #
 #   scripts/eval.sh speed [--scenarios "sim-multi tartanair"] [--rates "30 60"] [--frames N]
+#   (env SERVICE_ARGS="--set a.b=v ..." passes options to the live service)
 #
 # Per scenario and input rate: lcm-logplayer plays the 640x480 log at the rate, the
 # service runs live (stale frames dropped and counted), its summary.json gives the
@@ -66,10 +67,10 @@ for scenario in $scenarios; do
     speed=$(python3 -c "print($rate / $native)")
     "$MBSLAM_ROOT/test/netns/run_in_netns.sh" bash -c '
       set -u
-      bin="$1"; log="$2"; run="$3"; speed="$4"
+      bin="$1"; log="$2"; run="$3"; speed="$4"; shift 4
       url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
       /usr/bin/time -f "%M" -o "$run/time.txt" \
-        "$bin/perception_service" --lcm-url "$url" --mode realtime --output-dir "$run/result" \
+        "$bin/perception_service" --lcm-url "$url" --mode realtime --output-dir "$run/result" "$@" \
           2>"$run/service.log" &
       service=$!
       sleep 2
@@ -79,7 +80,7 @@ for scenario in $scenarios; do
       wait "$service"; s=$?
       echo "service exit $s" >&2
       [[ $s -eq 0 ]]
-    ' _ "$MBSLAM_BIN" "$log" "$run" "$speed" || { echo "speed: $scenario at $rate Hz failed; see $run/service.log" >&2; }
+    ' _ "$MBSLAM_BIN" "$log" "$run" "$speed" ${SERVICE_ARGS:-} || { echo "speed: $scenario at $rate Hz failed; see $run/service.log" >&2; }
   done
   # Lockstep headroom: every frame, as fast as it goes (inline bundle adjustment).
   lock="$out/$scenario/lockstep"

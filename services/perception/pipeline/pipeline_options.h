@@ -10,7 +10,7 @@ namespace mbslam {
 
 struct PipelineOptions {
   std::string mode = "realtime";        // "realtime" (drop stale frames) or "lockstep" (every frame, deterministic)
-  int image_queue_capacity = 2;         // realtime: images waiting for decode / processing (count)
+  int image_queue_capacity = 1;         // realtime: images waiting for decode / processing; 1 = only the newest waits (count)
   int lockstep_queue_capacity = 16;     // lockstep: events buffered before the reader blocks (count)
   int aux_queue_capacity = 4096;        // realtime: odometry / calibration events buffered (count)
   int max_image_dimension = 8192;       // larger width or height is rejected (px)
