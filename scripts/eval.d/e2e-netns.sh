@@ -19,7 +19,7 @@ cam_height=$(awk '!/^#/ && NF >= 8 {s += $4; n++} END {if (n) printf "%.3f", s /
 "$MBSLAM_ROOT/test/netns/run_in_netns.sh" bash -c '
   set -u
   bin="$1"; seq="$2"; live="$3"; root="$4"; cam_height="$5"
-  url="udpm://239.255.76.67:7667?ttl=0"
+  url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"  # 640x480 raw images: the default socket buffer holds less than one
   lcm-logger --lcm-url="$url" --quiet --channel="PERCEPTION_.*" "$live/outputs.lcmlog" 2>"$live/logger.log" &
   logger=$!
   "$bin/perception_service" --lcm-url "$url" --mode realtime --output-dir "$live/result" \
