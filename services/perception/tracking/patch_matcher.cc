@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <opencv2/imgproc.hpp>
@@ -50,34 +51,35 @@ PatchMatch FindPatchZssd(const cv::Mat& image, const cv::Mat& patch,
   const int y0 = std::max(half, cy - radius), y1 = std::min(image.rows - 1 - half, cy + radius);
   if (x0 > x1 || y0 > y1) return best;
 
-  // Template statistics.
+  // ZSSD / n = (sum (i - t)^2 - (sum i - sum t)^2 / n) / n: one pass of exact integer
+  // sums per position (at most 255^2 * n, n <= 31^2: fits 32 bits), no per-position mean
+  // pass.
   const int n = size * size;
-  double tmean = 0.0;
+  int64_t tsum = 0;
   for (int r = 0; r < size; ++r) {
     const uint8_t* p = patch.ptr<uint8_t>(r);
-    for (int c = 0; c < size; ++c) tmean += p[c];
+    for (int c = 0; c < size; ++c) tsum += p[c];
   }
-  tmean /= n;
-
   const int w = x1 - x0 + 1, h = y1 - y0 + 1;
   cv::Mat scores(h, w, CV_32F);
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
-      double sum = 0.0, sum_sq_diff = 0.0;
-      for (int r = 0; r < size; ++r) {
-        const uint8_t* ip = image.ptr<uint8_t>(y - half + r) + (x - half);
-        for (int c = 0; c < size; ++c) sum += ip[c];
-      }
-      const double imean = sum / n;
+      int64_t isum = 0, ssd = 0;
       for (int r = 0; r < size; ++r) {
         const uint8_t* ip = image.ptr<uint8_t>(y - half + r) + (x - half);
         const uint8_t* tp = patch.ptr<uint8_t>(r);
+        int32_t row_sum = 0, row_ssd = 0;
         for (int c = 0; c < size; ++c) {
-          const double d = (ip[c] - imean) - (tp[c] - tmean);
-          sum_sq_diff += d * d;
+          const int32_t d = static_cast<int32_t>(ip[c]) - static_cast<int32_t>(tp[c]);
+          row_sum += ip[c];
+          row_ssd += d * d;
         }
+        isum += row_sum;
+        ssd += row_ssd;
       }
-      scores.at<float>(y - y0, x - x0) = static_cast<float>(sum_sq_diff / n);
+      const double diff = static_cast<double>(isum - tsum);
+      scores.at<float>(y - y0, x - x0) =
+          static_cast<float>((static_cast<double>(ssd) - diff * diff / n) / n);
     }
   }
   cv::Point min_loc;
