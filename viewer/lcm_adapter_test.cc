@@ -16,17 +16,11 @@
 #include "common/util/atomic_file.h"
 #include "viewer/testing/synthetic_outputs.h"
 #include "viewer/viewer_app.h"
+#include "common/lcm/wire_check.h"
 
 namespace mbslam {
 namespace viewer {
 namespace {
-
-template <typename Msg>
-std::vector<uint8_t> Encode(const Msg& m) {
-  std::vector<uint8_t> buf(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  return buf;
-}
 
 std::string TempDir(const std::string& name) {
   const std::string dir =
@@ -127,12 +121,12 @@ TEST_F(AdapterTest, GoodMessagesReachTheScene) {
   adapter_->SetMessageTimeHook([&times](int64_t t) { times.push_back(t); });
   for (int k = 0; k < 6; ++k) {
     const testing::SyntheticFrame f = outputs.Frame(k);
-    Send(channels_.camera_image, Encode(f.image));
-    Send(channels_.perception_camera_pose, Encode(f.pose));
-    Send(channels_.perception_tracks, Encode(f.tracks));
-    Send(channels_.perception_objects, Encode(f.objects));
-    if (f.map) Send(channels_.perception_map, Encode(*f.map));
-    if (f.occupancy) Send(channels_.perception_occupancy, Encode(*f.occupancy));
+    Send(channels_.camera_image, mbslam::EncodeLcmMessage(f.image));
+    Send(channels_.perception_camera_pose, mbslam::EncodeLcmMessage(f.pose));
+    Send(channels_.perception_tracks, mbslam::EncodeLcmMessage(f.tracks));
+    Send(channels_.perception_objects, mbslam::EncodeLcmMessage(f.objects));
+    if (f.map) Send(channels_.perception_map, mbslam::EncodeLcmMessage(*f.map));
+    if (f.occupancy) Send(channels_.perception_occupancy, mbslam::EncodeLcmMessage(*f.occupancy));
   }
   EXPECT_EQ(adapter_->bad_total(), 0);
   EXPECT_EQ(adapter_->counts().at(channels_.camera_image).received, 6);
@@ -151,18 +145,18 @@ TEST_F(AdapterTest, BadMessagesAreCountedPerChannelAndDropped) {
   const testing::SyntheticOutputs outputs;
   const testing::SyntheticFrame f = outputs.Frame(5);
   // Truncated, garbage, wrong type, oversized, NaN pose.
-  const std::vector<uint8_t> map = Encode(*f.map);
+  const std::vector<uint8_t> map = mbslam::EncodeLcmMessage(*f.map);
   Send(channels_.perception_map, std::vector<uint8_t>(map.begin(), map.begin() + 100));
   Send(channels_.perception_objects, std::vector<uint8_t>(50, 0xab));
-  Send(channels_.perception_tracks, Encode(f.pose));
-  Send(channels_.camera_image, Encode(f.image));  // 921 kB < 1 MiB limit: fine
+  Send(channels_.perception_tracks, mbslam::EncodeLcmMessage(f.pose));
+  Send(channels_.camera_image, mbslam::EncodeLcmMessage(f.image));  // 921 kB < 1 MiB limit: fine
   mbslam::image_t big = f.image;
   big.data.resize(size_t{2} << 20);
   big.size = static_cast<int32_t>(big.data.size());
-  Send(channels_.camera_image, Encode(big));  // over the 1 MiB limit of this adapter
+  Send(channels_.camera_image, mbslam::EncodeLcmMessage(big));  // over the 1 MiB limit of this adapter
   mbslam::camera_pose_t nan_pose = f.pose;
   nan_pose.position[2] = std::nan("");
-  Send(channels_.perception_camera_pose, Encode(nan_pose));
+  Send(channels_.perception_camera_pose, mbslam::EncodeLcmMessage(nan_pose));
   Send(channels_.snapshot_request, {1, 2, 3});
   EXPECT_EQ(adapter_->counts().at(channels_.perception_map).bad, 1);
   EXPECT_EQ(adapter_->counts().at(channels_.perception_objects).bad, 1);

@@ -48,6 +48,15 @@ Status DecodeLcmMessage(const uint8_t* data, size_t size, Msg* msg,
   return Status::Ok();
 }
 
+// The encoding of a message (the counterpart of DecodeLcmMessage), for tests, tools and
+// log writers.
+template <typename Msg>
+std::vector<uint8_t> EncodeLcmMessage(const Msg& msg) {
+  std::vector<uint8_t> buf(static_cast<size_t>(msg.getEncodedSize()));
+  msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  return buf;
+}
+
 // The names of all types in the embedded schema, space separated (for tests and tools).
 std::string LcmSchemaTypeNames();
 

@@ -20,13 +20,6 @@
 namespace mbslam {
 namespace {
 
-template <typename Msg>
-std::vector<uint8_t> Encode(const Msg& m) {
-  std::vector<uint8_t> buf(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  return buf;
-}
-
 mbslam::image_t Image(int64_t utime, int64_t seq) {
   mbslam::image_t m{};
   m.utime = utime;
@@ -91,13 +84,13 @@ TEST_F(ServiceRobustness, BadInputOnEveryChannelIsCountedAndServiceKeepsRunning)
   calib.fx = calib.fy = 50;
   calib.cx = 31.5;
   calib.cy = 23.5;
-  Send(ch.camera_calibration, Encode(calib));
+  Send(ch.camera_calibration, mbslam::EncodeLcmMessage(calib));
   int64_t t = 1000000;
-  for (int i = 0; i < 5; ++i, t += 33333) Send(ch.camera_image, Encode(Image(t, i)));
+  for (int i = 0; i < 5; ++i, t += 33333) Send(ch.camera_image, mbslam::EncodeLcmMessage(Image(t, i)));
 
   // CAMERA_IMAGE: truncated, corrupted, oversized claim, wrong size, unknown encoding,
   // time backwards.
-  std::vector<uint8_t> img = Encode(Image(t, 5));
+  std::vector<uint8_t> img = mbslam::EncodeLcmMessage(Image(t, 5));
   Send(ch.camera_image, img, img.size() / 2);
   std::vector<uint8_t> corrupt = img;
   corrupt[0] ^= 0xFF;
@@ -109,31 +102,31 @@ TEST_F(ServiceRobustness, BadInputOnEveryChannelIsCountedAndServiceKeepsRunning)
   Send(ch.camera_image, huge);
   mbslam::image_t wrong = Image(t, 5);
   wrong.height = 4800;
-  Send(ch.camera_image, Encode(wrong));
+  Send(ch.camera_image, mbslam::EncodeLcmMessage(wrong));
   mbslam::image_t enc = Image(t, 5);
   enc.encoding = 99;
-  Send(ch.camera_image, Encode(enc));
-  Send(ch.camera_image, Encode(Image(t - 500000, 5)));
+  Send(ch.camera_image, mbslam::EncodeLcmMessage(enc));
+  Send(ch.camera_image, mbslam::EncodeLcmMessage(Image(t - 500000, 5)));
   // CAMERA_CALIBRATION: truncated, NaN.
-  std::vector<uint8_t> cal = Encode(calib);
+  std::vector<uint8_t> cal = mbslam::EncodeLcmMessage(calib);
   Send(ch.camera_calibration, cal, cal.size() - 3);
   mbslam::camera_calibration_t nan_calib = calib;
   nan_calib.cx = NAN;
-  Send(ch.camera_calibration, Encode(nan_calib));
+  Send(ch.camera_calibration, mbslam::EncodeLcmMessage(nan_calib));
   // ODOMETRY: garbage, NaN.
   std::vector<uint8_t> garbage(1000, 0xEE);
   Send(ch.odometry, garbage);
   mbslam::odometry_t odom{};
   odom.utime = t;
   odom.orientation[0] = NAN;
-  Send(ch.odometry, Encode(odom));
+  Send(ch.odometry, mbslam::EncodeLcmMessage(odom));
   // SNAPSHOT_REQUEST: truncated.
   mbslam::snapshot_request_t snap{};
   snap.path_prefix = "/tmp/x";
-  std::vector<uint8_t> sb = Encode(snap);
+  std::vector<uint8_t> sb = mbslam::EncodeLcmMessage(snap);
   Send(ch.snapshot_request, sb, 5);
 
-  for (int i = 0; i < 5; ++i, t += 33333) Send(ch.camera_image, Encode(Image(t, 5 + i)));
+  for (int i = 0; i < 5; ++i, t += 33333) Send(ch.camera_image, mbslam::EncodeLcmMessage(Image(t, 5 + i)));
   std::map<std::string, int64_t> c = FinalCounters();
 
   EXPECT_EQ(poses_, 10) << "every valid image produced an output";
@@ -181,7 +174,7 @@ TEST(ServiceSnapshotRequests, PathsOutsideTheOutputDirAreRefused) {
     r.utime = 1;
     r.path_prefix = prefix;
     r.what = mbslam::snapshot_request_t::WHAT_OUTPUTS;
-    const std::vector<uint8_t> b = Encode(r);
+    const std::vector<uint8_t> b = mbslam::EncodeLcmMessage(r);
     bus->PublishRaw(options.channels.snapshot_request, b.data(), static_cast<unsigned>(b.size()));
     while (bus->HandleTimeout(0) > 0) {
     }

@@ -17,13 +17,6 @@ namespace mbslam {
 namespace fault {
 namespace {
 
-template <typename Msg>
-std::vector<uint8_t> Encode(const Msg& m) {
-  std::vector<uint8_t> buf(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  return buf;
-}
-
 constexpr size_t kUtimeOffset = 8;  // after the type fingerprint
 
 }  // namespace
@@ -139,7 +132,7 @@ Status LogEditor::AddOdometryFromTruth(const double base_from_cam_wxyz[4], const
     LcmLogEvent odom;
     odom.channel = channels_.odometry;
     odom.timestamp = timestamp;
-    odom.data = Encode(o);
+    odom.data = mbslam::EncodeLcmMessage(o);
     out.push_back(std::move(odom));
   }
   events_ = std::move(out);
@@ -215,7 +208,7 @@ int LogEditor::CorruptOdometry(int64_t from_utime, int64_t to_utime, double valu
       case 2: msg.linear_velocity[changed % 3] = value; break;
       case 3: msg.angular_velocity[changed % 3] = value; break;
     }
-    e.data = Encode(msg);
+    e.data = mbslam::EncodeLcmMessage(msg);
     ++changed;
   }
   return changed;
@@ -243,7 +236,7 @@ Status LogEditor::InjectBadCalibration(int at_frame, double value) {
   int64_t frame_utime = 0;
   ReadMessageUtime(events_[at].data, &frame_utime);
   calib.utime = frame_utime;
-  bad.data = Encode(calib);
+  bad.data = mbslam::EncodeLcmMessage(calib);
   events_.insert(events_.begin() + static_cast<std::ptrdiff_t>(at), std::move(bad));
   return Status::Ok();
 }
@@ -272,7 +265,7 @@ Status LogEditor::ResizeFrame(int frame, int width, int height) {
   img.row_stride = width * channels;
   img.data.assign(dst.data, dst.data + dst.total() * dst.elemSize());
   img.size = static_cast<int32_t>(img.data.size());
-  e.data = Encode(img);
+  e.data = mbslam::EncodeLcmMessage(img);
   return Status::Ok();
 }
 

@@ -18,15 +18,9 @@
 #include "mbslam/camera_calibration_t.hpp"
 #include "mbslam/image_t.hpp"
 #include "mbslam/odometry_t.hpp"
+#include "common/lcm/wire_check.h"
 
 namespace {
-
-template <typename Msg>
-std::vector<uint8_t> Encode(const Msg& m) {
-  std::vector<uint8_t> buf(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  return buf;
-}
 
 }  // namespace
 
@@ -107,7 +101,7 @@ int main(int argc, char** argv) {
     log->Write(ch.camera_image, t, img);
 
     if (faults && k % 10 == 5) {
-      std::vector<uint8_t> bytes = Encode(img);
+      std::vector<uint8_t> bytes = mbslam::EncodeLcmMessage(img);
       log->WriteRaw(ch.camera_image, t + 1, bytes.data(), bytes.size() / 3);  // truncated
       bytes[1] ^= 0x40;
       log->WriteRaw(ch.camera_image, t + 2, bytes.data(), bytes.size());      // bad fingerprint

@@ -9,6 +9,7 @@
 #include "mbslam/camera_calibration_t.hpp"
 #include "mbslam/image_t.hpp"
 #include "mbslam/odometry_t.hpp"
+#include "common/lcm/wire_check.h"
 
 namespace mbslam {
 namespace {
@@ -31,13 +32,6 @@ class NullSink : public OutputSink {
  public:
   void OnFrameResult(const FrameResult&) override {}
 };
-
-template <typename Msg>
-std::vector<uint8_t> Encode(const Msg& m) {
-  std::vector<uint8_t> buf(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  return buf;
-}
 
 mbslam::image_t Image(int64_t utime, int64_t seq, int w = 16, int h = 8) {
   mbslam::image_t m{};
@@ -62,7 +56,7 @@ struct Fixture {
     pipeline->Start();
   }
   void Feed(const mbslam::image_t& m) {
-    const auto b = Encode(m);
+    const auto b = mbslam::EncodeLcmMessage(m);
     adapter->HandleImage(b.data(), b.size(), 1);
   }
   void Finish() { pipeline->Stop(); }
@@ -79,7 +73,7 @@ struct Fixture {
 TEST(InputAdapter, CorruptTruncatedAndOversizedImagesAreCounted) {
   Fixture f;
   f.Feed(Image(1000, 0));
-  std::vector<uint8_t> bytes = Encode(Image(2000, 1));
+  std::vector<uint8_t> bytes = mbslam::EncodeLcmMessage(Image(2000, 1));
   f.adapter->HandleImage(bytes.data(), bytes.size() / 2, 1);  // truncated
   bytes[2] ^= 0xFF;  // corrupted type fingerprint
   f.adapter->HandleImage(bytes.data(), bytes.size(), 1);
@@ -144,15 +138,15 @@ TEST(InputAdapter, CalibrationMessagesValidatedAndApplied) {
   c.distortion_model = mbslam::camera_calibration_t::DISTORTION_NONE;
   mbslam::camera_calibration_t bad = c;
   bad.fx = NAN;
-  auto b = Encode(bad);
+  auto b = mbslam::EncodeLcmMessage(bad);
   f.adapter->HandleCalibration(b.data(), b.size());
   f.Feed(Image(1000, 0));  // uncalibrated: fallback f = width
-  b = Encode(c);
+  b = mbslam::EncodeLcmMessage(c);
   f.adapter->HandleCalibration(b.data(), b.size());
   f.Feed(Image(2000, 1));
   mbslam::camera_calibration_t other = c;
   other.width = 32;
-  b = Encode(other);
+  b = mbslam::EncodeLcmMessage(other);
   f.adapter->HandleCalibration(b.data(), b.size());
   f.Feed(Image(3000, 2));  // size differs from calibration: rejected
   f.Finish();
@@ -169,18 +163,18 @@ TEST(InputAdapter, OdometryNaNAndTimeBackwardsCounted) {
   mbslam::odometry_t o{};
   o.utime = 1000;
   o.orientation[0] = 1.0;
-  auto b = Encode(o);
+  auto b = mbslam::EncodeLcmMessage(o);
   f.adapter->HandleOdometry(b.data(), b.size());
   o.utime = 500;
-  b = Encode(o);
+  b = mbslam::EncodeLcmMessage(o);
   f.adapter->HandleOdometry(b.data(), b.size());
   o.utime = 2000;
   o.position[1] = INFINITY;
-  b = Encode(o);
+  b = mbslam::EncodeLcmMessage(o);
   f.adapter->HandleOdometry(b.data(), b.size());
   o.position[1] = 0;
   o.orientation[0] = 0.5;  // not unit
-  b = Encode(o);
+  b = mbslam::EncodeLcmMessage(o);
   f.adapter->HandleOdometry(b.data(), b.size());
   f.adapter->HandleOdometry(b.data(), 7);
   f.Finish();
