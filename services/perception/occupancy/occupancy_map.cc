@@ -98,9 +98,11 @@ OccupancyInsertSummary OccupancyMap::InsertRays(
   }
 
   InsertBatch(batch, &summary);
+  const Eigen::Vector3d origin = batch.origin;
   if (options_.max_stored_rays > 0) {
     StoreBatch(std::move(batch));
   }
+  BoundMemory(origin);
   ++revision_;
   return summary;
 }
@@ -198,6 +200,54 @@ void OccupancyMap::StoreBatch(RayBatch batch) {
   }
 }
 
+int64_t OccupancyMap::MemoryBytes() const {
+  if (!tree_) return 0;
+  // Each node is a 16-byte allocation (32 with glibc's header and alignment); an inner
+  // node also holds an array of 8 child pointers (80 bytes allocated), and in these
+  // trees about one node in four is inner (measured, occupancy_map_test).
+  constexpr int64_t kBytesPerNode = 32 + 80 / 4;
+  return static_cast<int64_t>(tree_->size()) * kBytesPerNode;
+}
+
+void OccupancyMap::BoundMemory(const Eigen::Vector3d& center) {
+  if (!tree_ || options_.max_memory_mb <= 0.0) return;
+  const double limit = options_.max_memory_mb * 1024.0 * 1024.0;
+  if (static_cast<double>(MemoryBytes()) <= limit) return;
+  octomap::OcTreeKey c;
+  if (!KeyInTree(*tree_, ToOcto(center), c)) return;
+  const double res = tree_->getResolution();
+  const int64_t occupied_before = num_occupied_;
+  int half = options_.keep_half_edge_voxels;
+  while (true) {
+    octomap::OcTreeKey lo, hi;
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = static_cast<octomap::key_type>(std::max(0, static_cast<int>(c[i]) - half));
+      hi[i] = static_cast<octomap::key_type>(std::min(65535, static_cast<int>(c[i]) + half));
+    }
+    int64_t occupied = 0;
+    tree_ = CropOctree(*tree_, lo, hi, &occupied);
+    num_occupied_ = occupied;
+    // Stored rays from outside the box would bring the dropped voxels back on a rebuild.
+    const double reach = (half + 0.5) * res;
+    for (auto it = batches_.begin(); it != batches_.end();) {
+      if (((it->origin - center).cwiseAbs().array() > reach).any()) {
+        stored_rays_ -= static_cast<int64_t>(it->ends.size());
+        rays_forgotten_ += static_cast<int64_t>(it->ends.size());
+        it = batches_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    if (static_cast<double>(MemoryBytes()) <= 0.5 * limit || half <= 1) break;
+    half /= 2;
+  }
+  ++crops_;
+  occupied_dropped_ += std::max<int64_t>(0, occupied_before - num_occupied_);
+  MBSLAM_LOG(INFO) << "occupancy: memory bound of " << options_.max_memory_mb << " MB reached; kept the "
+                   << 2 * half + 1 << " voxel box around the camera (" << tree_->size() << " nodes, "
+                   << occupied_before - num_occupied_ << " occupied voxels dropped)";
+}
+
 double OccupancyMap::MedianStoredRayLength() const {
   std::vector<double> lengths;
   lengths.reserve(static_cast<size_t>(stored_rays_));
@@ -249,6 +299,9 @@ Status OccupancyMap::Rescale(double factor, Units units) {
     Rebuild(resolution, max_range);
   } else if (tree_) {
     Rebuild(tree_->getResolution() * factor, max_range_ > 0.0 ? max_range_ * factor : max_range_);
+  }
+  if (tree_ && !batches_.empty()) {
+    BoundMemory(batches_.back().origin);
   }
   if (tree_) {
     StoreBatch(RayBatch());  // the bound applies once the tree exists

@@ -25,6 +25,12 @@
 // are forgotten first; a rebuild then lacks their evidence, counted in
 // rays_forgotten()).
 //
+// Bounded memory. A robot that keeps exploring (or a monocular map whose gauge drifts)
+// adds voxels without end. When the tree's memory estimate exceeds `max_memory_mb` the
+// tree is cropped to the voxels within `keep_half_edge_voxels` (per axis) of the latest
+// ray origin, halving that box until the tree is below half the bound, and stored rays
+// from outside the box are forgotten. Counted in crops() and voxels_dropped().
+//
 // Not thread-safe; the algorithm layer has no threads of its own.
 
 #include <cstddef>
@@ -76,6 +82,12 @@ struct OccupancyMapOptions {
   double occupancy_threshold = 0.5;
   // Rays kept to rebuild the tree after a rescale (count); 0 keeps none.
   int max_stored_rays = 1000000;
+  // Estimated memory of the tree above which it is cropped around the latest ray origin
+  // (MB); 0 = unbounded.
+  double max_memory_mb = 64.0;
+  // Half edge of the box kept around the latest ray origin by a crop (voxels); halved
+  // until the tree is below half of max_memory_mb.
+  int keep_half_edge_voxels = 1024;
   // Rays of one insert are first reduced to one per end voxel (faster, slightly
   // different result: OctoMap's discretised update) (bool).
   bool discretize = false;
@@ -97,6 +109,9 @@ struct OccupancyMapOptions {
     MBSLAM_CHECK_OPTION_GT(occupancy_threshold, 0.0);
     MBSLAM_CHECK_OPTION_LT(occupancy_threshold, 1.0);
     MBSLAM_CHECK_OPTION_GE(max_stored_rays, 0);
+    MBSLAM_CHECK_OPTION_GE(max_memory_mb, 0.0);
+    MBSLAM_CHECK_OPTION_GE(keep_half_edge_voxels, 1);
+    MBSLAM_CHECK_OPTION_LE(keep_half_edge_voxels, 32767);
     return true;
   }
 
@@ -123,6 +138,12 @@ struct OccupancyMapOptions {
     v("max_stored_rays", &max_stored_rays,
       "rays kept to rebuild the tree after a rescale, oldest forgotten first; 0 keeps none "
       "(count)");
+    v("max_memory_mb", &max_memory_mb,
+      "estimated tree memory above which it is cropped around the latest ray origin; 0 = "
+      "unbounded (MB)");
+    v("keep_half_edge_voxels", &keep_half_edge_voxels,
+      "half edge of the box kept around the latest ray origin by a crop, halved until the tree "
+      "is below half of max_memory_mb (voxels)");
     v("discretize", &discretize,
       "reduce the rays of one insert to one per end voxel first (faster, slightly different)");
   }
@@ -188,6 +209,13 @@ class OccupancyMap {
   Units units() const { return units_; }
   const OccupancyMapOptions& options() const { return options_; }
 
+  // Estimated memory of the tree: its nodes, their child arrays and the allocator's
+  // overhead (bytes); O(1).
+  int64_t MemoryBytes() const;
+  // Crops done to bound the memory, and the occupied voxels they dropped (count).
+  int64_t crops() const { return crops_; }
+  int64_t occupied_voxels_dropped() const { return occupied_dropped_; }
+
   int64_t num_stored_rays() const { return stored_rays_; }
   int64_t rays_forgotten() const { return rays_forgotten_; }
   // Number of InsertRays calls and Rescale rebuilds that changed the tree (count); a
@@ -208,6 +236,8 @@ class OccupancyMap {
   void Rebuild(double resolution, double max_range);
   void InsertBatch(const RayBatch& batch, OccupancyInsertSummary* summary);
   void StoreBatch(RayBatch batch);
+  // Applies the memory bound around `center` (map units).
+  void BoundMemory(const Eigen::Vector3d& center);
   // Up-to-scale start: median ray length of the stored rays.
   double MedianStoredRayLength() const;
   // Resolution and range for metres from the options.
@@ -225,6 +255,8 @@ class OccupancyMap {
   int64_t stored_rays_ = 0;
   int64_t rays_forgotten_ = 0;
   int64_t revision_ = 0;
+  int64_t crops_ = 0;
+  int64_t occupied_dropped_ = 0;
 };
 
 const char* OccupancyUnitsName(OccupancyMap::Units units);

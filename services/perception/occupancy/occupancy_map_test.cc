@@ -369,6 +369,67 @@ TEST(OccupancyMap, StoredRaysAreBounded) {
   EXPECT_GT(none.NumOccupied(), 0);
 }
 
+TEST(OccupancyMap, MemoryEstimateFollowsTheTree) {
+  OccupancyMap map(Metric(0.05, 10.0), OccupancyMap::Units::kMetres);
+  for (int s = 0; s < 10; ++s) {
+    map.InsertRays(Eigen::Vector3d(0.3 * s, 0.0, 0.0), WallPoints(6.0 + 0.3 * s, 0.05));
+  }
+  const octomap::OcTree* tree = map.tree();
+  ASSERT_NE(tree, nullptr);
+  // OctoMap's own count (nodes and child arrays, without the allocator's overhead) is a
+  // lower bound; the estimate adds the allocator's share and stays within 2x of it.
+  const double octomap_bytes = static_cast<double>(tree->memoryUsage());
+  EXPECT_GE(static_cast<double>(map.MemoryBytes()), octomap_bytes);
+  EXPECT_LE(static_cast<double>(map.MemoryBytes()), 2.5 * octomap_bytes);
+  const double inner_share =
+      1.0 - static_cast<double>(tree->getNumLeafNodes()) / static_cast<double>(tree->size());
+  EXPECT_LT(inner_share, 0.4);
+}
+
+TEST(OccupancyMap, MemoryBoundCropsAroundTheCamera) {
+  OccupancyMapOptions bounded = Metric(0.05, 6.0);
+  bounded.max_memory_mb = 4.0;
+  bounded.keep_half_edge_voxels = 100;  // 5 m
+  OccupancyMap map(bounded, OccupancyMap::Units::kMetres);
+  OccupancyMap unbounded(Metric(0.05, 6.0), OccupancyMap::Units::kMetres);
+  // The camera drives 40 m along x past a wall 3 m to its side.
+  Eigen::Vector3d camera;
+  int64_t max_unbounded = 0;
+  for (int s = 0; s <= 80; ++s) {
+    camera = Eigen::Vector3d(0.5 * s, 0.0, 0.0);
+    std::vector<Eigen::Vector3d> points;
+    for (double x = -2.0; x <= 2.0; x += 0.05) {
+      for (double z = -0.5; z <= 0.5; z += 0.25) points.emplace_back(camera.x() + x, 3.02, z);
+    }
+    map.InsertRays(camera, points);
+    unbounded.InsertRays(camera, points);
+    EXPECT_LE(map.MemoryBytes(), 4 * 1024 * 1024) << "step " << s;
+    max_unbounded = std::max(max_unbounded, unbounded.MemoryBytes());
+  }
+  EXPECT_GT(map.crops(), 0);
+  EXPECT_GT(map.occupied_voxels_dropped(), 0);
+  EXPECT_GT(map.rays_forgotten(), 0);
+  EXPECT_GT(max_unbounded, 8 * 1024 * 1024);
+  // Near the camera the bounded map is the unbounded one; the start of the drive is gone.
+  EXPECT_TRUE(map.IsOccupied(Eigen::Vector3d(camera.x(), 3.02, 0.0)));
+  int same = 0, checked = 0;
+  for (double x = camera.x() - 3.0; x <= camera.x(); x += 0.05) {
+    for (double y = 0.0; y <= 3.02; y += 0.25) {
+      const Eigen::Vector3d p(x, y, 0.0);
+      ++checked;
+      same += map.Occupancy(p) == unbounded.Occupancy(p);
+    }
+  }
+  EXPECT_EQ(same, checked);
+  EXPECT_FALSE(map.Occupancy(Eigen::Vector3d(0.0, 3.02, 0.0)).has_value());
+  EXPECT_TRUE(unbounded.IsOccupied(Eigen::Vector3d(0.0, 3.02, 0.0)));
+  EXPECT_LT(map.NumOccupied(), unbounded.NumOccupied());
+  // A rebuild after a rescale starts from the kept rays only and stays bounded.
+  ASSERT_TRUE(map.Rescale(1.0, OccupancyMap::Units::kMetres).ok());
+  EXPECT_LE(map.MemoryBytes(), 4 * 1024 * 1024);
+  EXPECT_TRUE(map.IsOccupied(Eigen::Vector3d(camera.x(), 3.02, 0.0)));
+}
+
 TEST(OccupancyMapOptions, CheckAndYaml) {
   OccupancyMapOptions options;
   EXPECT_TRUE(options.Check());

@@ -236,6 +236,105 @@ int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates)
   return delta;
 }
 
+namespace {
+
+// An OcTree whose root can be created directly (OctoMap creates it only inside its
+// update functions). Behaves as an octomap::OcTree in every other way.
+class CroppedOcTree : public octomap::OcTree {
+ public:
+  using octomap::OcTree::OcTree;
+  octomap::OcTreeNode* CreateRoot() {
+    root = new octomap::OcTreeNode();
+    ++tree_size;
+    size_changed = true;
+    return root;
+  }
+};
+
+// Key range of a node at `depth` whose first (lowest) key is `lo`: [lo, lo + span).
+struct NodeBox {
+  std::array<unsigned, 3> lo;
+  unsigned span;
+};
+
+bool Overlaps(const NodeBox& b, const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key) {
+  for (int i = 0; i < 3; ++i) {
+    if (b.lo[i] > max_key[i] || b.lo[i] + b.span - 1 < min_key[i]) return false;
+  }
+  return true;
+}
+
+bool Inside(const NodeBox& b, const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key) {
+  for (int i = 0; i < 3; ++i) {
+    if (b.lo[i] < min_key[i] || b.lo[i] + b.span - 1 > max_key[i]) return false;
+  }
+  return true;
+}
+
+NodeBox ChildBox(const NodeBox& b, unsigned pos) {
+  NodeBox c;
+  c.span = b.span / 2;
+  for (int i = 0; i < 3; ++i) c.lo[i] = b.lo[i] + (((pos >> i) & 1u) ? c.span : 0u);
+  return c;
+}
+
+// True when the subtree of `node` (box `b`) has a leaf overlapping the key box.
+bool HasLeafInBox(const octomap::OcTree& tree, const octomap::OcTreeNode* node, const NodeBox& b,
+                  const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key) {
+  if (!Overlaps(b, min_key, max_key)) return false;
+  if (!tree.nodeHasChildren(node) || Inside(b, min_key, max_key)) return true;
+  for (unsigned pos = 0; pos < 8; ++pos) {
+    if (tree.nodeChildExists(node, pos) &&
+        HasLeafInBox(tree, tree.getNodeChild(node, pos), ChildBox(b, pos), min_key, max_key)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// Copies the overlapping part of `src` (box `b`, known to hold a leaf in the key box)
+// into the existing node `dst`.
+void CopyOverlap(const octomap::OcTree& src_tree, const octomap::OcTreeNode* src, const NodeBox& b,
+                 const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key, bool inside,
+                 octomap::OcTree* dst_tree, octomap::OcTreeNode* dst, int64_t* num_occupied) {
+  if (!src_tree.nodeHasChildren(src)) {
+    dst->setLogOdds(src->getLogOdds());
+    if (src_tree.isNodeOccupied(src)) *num_occupied += int64_t{1} << (3 * (63 - __builtin_clzll(b.span)));
+    return;
+  }
+  for (unsigned pos = 0; pos < 8; ++pos) {
+    if (!src_tree.nodeChildExists(src, pos)) continue;
+    const octomap::OcTreeNode* child = src_tree.getNodeChild(src, pos);
+    const NodeBox cb = ChildBox(b, pos);
+    const bool child_inside = inside || Inside(cb, min_key, max_key);
+    if (!child_inside && !HasLeafInBox(src_tree, child, cb, min_key, max_key)) continue;
+    octomap::OcTreeNode* d = dst_tree->createNodeChild(dst, pos);
+    CopyOverlap(src_tree, child, cb, min_key, max_key, child_inside, dst_tree, d, num_occupied);
+  }
+  dst->updateOccupancyChildren();
+}
+
+}  // namespace
+
+std::unique_ptr<octomap::OcTree> CropOctree(const octomap::OcTree& tree, const octomap::OcTreeKey& min_key,
+                                            const octomap::OcTreeKey& max_key, int64_t* num_occupied) {
+  auto out = std::make_unique<CroppedOcTree>(tree.getResolution());
+  out->setProbHit(tree.getProbHit());
+  out->setProbMiss(tree.getProbMiss());
+  out->setClampingThresMin(tree.getClampingThresMin());
+  out->setClampingThresMax(tree.getClampingThresMax());
+  out->setOccupancyThres(tree.getOccupancyThres());
+  int64_t occupied = 0;
+  const octomap::OcTreeNode* root = tree.getRoot();
+  const NodeBox box{{0u, 0u, 0u}, 1u << kTreeDepth};
+  if (root != nullptr && HasLeafInBox(tree, root, box, min_key, max_key)) {
+    CopyOverlap(tree, root, box, min_key, max_key, Inside(box, min_key, max_key), out.get(), out->CreateRoot(),
+                &occupied);
+  }
+  if (num_occupied != nullptr) *num_occupied = occupied;
+  return out;
+}
+
 void WriteOctreeBinary(const octomap::OcTree& tree, std::string* out) {
   const octomap::OcTreeNode* root = tree.getRoot();
   std::string data;

@@ -17,6 +17,7 @@
 #include <octomap/OcTree.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,18 @@ inline uint64_t VoxelUpdate(const octomap::OcTreeKey& key, bool hit) {
 // pruned). Sorts `updates` in place. Returns the change in the number of occupied
 // voxels at the finest resolution.
 int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates);
+
+// A new tree with the parameters of `tree` (resolution, hit / miss log-odds, clamping,
+// occupancy threshold) holding the nodes of `tree` that overlap the box of finest-level
+// keys [min_key, max_key] (inclusive, per axis), with their values; a pruned leaf that
+// straddles the box is kept whole. Inner nodes take the maximum of their kept children
+// (OctoMap's non-lazy convention). Used to bound the memory of a long-running map: the
+// copy costs one walk over the kept part. `num_occupied` (optional): occupied voxels of
+// the copy at the finest resolution.
+std::unique_ptr<octomap::OcTree> CropOctree(const octomap::OcTree& tree,
+                                            const octomap::OcTreeKey& min_key,
+                                            const octomap::OcTreeKey& max_key,
+                                            int64_t* num_occupied);
 
 // Appends to `out` exactly what `octomap::OcTree copy(tree); copy.writeBinary(stream)`
 // would write.

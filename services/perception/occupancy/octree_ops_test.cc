@@ -196,5 +196,88 @@ TEST(OctreeOps, WriteBinaryMatchesOctomap) {
   EXPECT_EQ(OurWriteBinary(one), OctomapWriteBinary(one));
 }
 
+// A tree from a few scans along a line (free space, walls, floor; pruned regions).
+octomap::OcTree ScannedTree(double resolution) {
+  octomap::OcTree tree(resolution);
+  std::mt19937 rng(11);
+  for (int s = 0; s < 12; ++s) {
+    const octomap::point3d origin(0.5f * static_cast<float>(s), 0.1f * static_cast<float>(s), 0.5f);
+    Insert(&tree, Scan(&rng, origin, 400), origin, 8.0);
+  }
+  return tree;
+}
+
+TEST(OctreeOps, CropToEverythingIsTheSameTree) {
+  const octomap::OcTree tree = ScannedTree(0.1);
+  int64_t occupied = -1;
+  const auto copy = CropOctree(tree, octomap::OcTreeKey(0, 0, 0), octomap::OcTreeKey(65535, 65535, 65535), &occupied);
+  EXPECT_EQ(OurWriteBinary(*copy), OurWriteBinary(tree));
+  EXPECT_EQ(copy->size(), tree.size());
+  EXPECT_EQ(copy->getNumLeafNodes(), tree.getNumLeafNodes());
+  EXPECT_EQ(occupied, CountOccupied(tree));
+  EXPECT_EQ(copy->memoryUsage(), tree.memoryUsage());
+  // Probabilities, not only the maximum-likelihood tree: every leaf has the same value.
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    const octomap::OcTreeNode* n = copy->search(it.getKey(), it.getDepth());
+    ASSERT_NE(n, nullptr);
+    EXPECT_EQ(n->getLogOdds(), it->getLogOdds());
+  }
+  EXPECT_DOUBLE_EQ(copy->getProbHit(), tree.getProbHit());
+  EXPECT_DOUBLE_EQ(copy->getClampingThresMax(), tree.getClampingThresMax());
+}
+
+TEST(OctreeOps, CropKeepsTheBoxAndDropsTheRest) {
+  const octomap::OcTree tree = ScannedTree(0.1);
+  octomap::OcTreeKey c;
+  ASSERT_TRUE(tree.coordToKeyChecked(octomap::point3d(2.0f, 0.5f, 0.5f), c));
+  const int half = 20;
+  const octomap::OcTreeKey lo(c[0] - half, c[1] - half, c[2] - half);
+  const octomap::OcTreeKey hi(c[0] + half, c[1] + half, c[2] + half);
+  int64_t occupied = -1;
+  const auto crop = CropOctree(tree, lo, hi, &occupied);
+  EXPECT_LT(crop->size(), tree.size());
+  EXPECT_GT(crop->size(), 0u);
+  EXPECT_EQ(occupied, CountOccupied(*crop));
+  // Inside the box: the same value at the finest resolution as the original.
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> u(-half, half);
+  int known = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const octomap::OcTreeKey k(c[0] + u(rng), c[1] + u(rng), c[2] + u(rng));
+    const octomap::OcTreeNode* a = tree.search(k);
+    const octomap::OcTreeNode* b = crop->search(k);
+    ASSERT_EQ(a == nullptr, b == nullptr);
+    if (a != nullptr) {
+      EXPECT_EQ(a->getLogOdds(), b->getLogOdds());
+      ++known;
+    }
+  }
+  EXPECT_GT(known, 100);
+  // Every kept leaf overlaps the box.
+  for (auto it = crop->begin_leafs(); it != crop->end_leafs(); ++it) {
+    const unsigned span = 1u << (16 - it.getDepth());
+    const octomap::OcTreeKey k = it.getIndexKey();
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_LE(k[a], hi[a]);
+      EXPECT_GE(k[a] + span - 1, lo[a]);
+    }
+  }
+  // Inner nodes hold the maximum of their children, as after OctoMap's own updates: the
+  // maximum-likelihood writer of the crop agrees with OctoMap's.
+  EXPECT_EQ(OurWriteBinary(*crop), OctomapWriteBinary(*crop));
+}
+
+TEST(OctreeOps, CropOfAnEmptyRegionOrTreeIsEmpty) {
+  const octomap::OcTree tree = ScannedTree(0.1);
+  int64_t occupied = -1;
+  const auto far = CropOctree(tree, octomap::OcTreeKey(0, 0, 0), octomap::OcTreeKey(10, 10, 10), &occupied);
+  EXPECT_EQ(far->size(), 0u);
+  EXPECT_EQ(far->getRoot(), nullptr);
+  EXPECT_EQ(occupied, 0);
+  const octomap::OcTree empty(0.1);
+  const auto none = CropOctree(empty, octomap::OcTreeKey(0, 0, 0), octomap::OcTreeKey(65535, 65535, 65535), nullptr);
+  EXPECT_EQ(none->size(), 0u);
+}
+
 }  // namespace
 }  // namespace mbslam

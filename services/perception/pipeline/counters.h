@@ -70,13 +70,16 @@ inline constexpr const char* kTrackingLost = "tracking_lost";                   
 inline constexpr const char* kTrackingRecovered = "tracking_recovered";         // back to OK after a loss
 inline constexpr const char* kMapPointsCulled = "map_points_culled";            // left with their culled keyframes
 inline constexpr const char* kObjectRecordsPruned = "object_records_pruned";    // per-object state of objects gone
+inline constexpr const char* kOccupancyCrops = "occupancy_crops";                // memory bound: cropped around the camera
+inline constexpr const char* kOccupancyVoxelsDropped = "occupancy_voxels_dropped";  // occupied voxels those crops dropped
 }  // namespace counter
 
 // Counters that report recoveries or routine housekeeping, not problems: they do not make
 // the state DEGRADED.
 inline bool IsInformationalCounter(const std::string& name) {
   return name == counter::kTrackingRecovered || name == counter::kMapPointsCulled ||
-         name == counter::kObjectRecordsPruned;
+         name == counter::kObjectRecordsPruned || name == counter::kOccupancyCrops ||
+         name == counter::kOccupancyVoxelsDropped;
 }
 
 }  // namespace mbslam

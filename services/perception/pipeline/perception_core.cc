@@ -242,7 +242,13 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
   for (int64_t id : update.new_point_ids) {
     if (const MapPoint* p = slam_.map().point(id)) points.push_back(p->position);
   }
+  const int64_t crops_before = occupancy_->crops();
+  const int64_t dropped_before = occupancy_->occupied_voxels_dropped();
   occupancy_->InsertRays(kf->cam_from_world.Inverse().translation, points);
+  if (occupancy_->crops() > crops_before) {
+    counters_->Increment(counter::kOccupancyCrops, occupancy_->crops() - crops_before);
+    counters_->Increment(counter::kOccupancyVoxelsDropped, occupancy_->occupied_voxels_dropped() - dropped_before);
+  }
   if (!occupancy_->IsResolutionFixed()) return;
   // Serialising a large tree costs tens of ms: publish at most once per period.
   if (last_occupancy_publish_utime_ && utime - *last_occupancy_publish_utime_ < options_.occupancy_publish_period_us) return;
