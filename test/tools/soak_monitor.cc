@@ -6,8 +6,8 @@
 // map_observations sums keyframe_t.num_observations (point observations held by keyframes).
 // trajectory_poses counts what the service keeps for its trajectory files: tracked camera
 // poses plus tracked / reconstructed object poses (ResultRecorder, 64 B each).
-// occupancy_mem_bytes is what the published OcTree takes in memory (OcTree::memoryUsage
-// of the tree read back), i.e. what the service's own copy of it holds.
+// occupancy_mem_bytes is the service's estimate of its own probabilistic tree
+// (occupancy_t.memory_bytes), the memory occupancy.max_memory_mb bounds.
 //
 //   soak_monitor --url URL --pid PID --seconds S [--interval S]
 //
@@ -18,10 +18,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 #include <string>
 
-#include <octomap/OcTree.h>
 
 #include "common/lcm/channels.h"
 #include "common/lcm/lcm_bus.h"
@@ -91,9 +89,9 @@ int main(int argc, char** argv) {
     mbslam::occupancy_t m{};
     if (!mbslam::DecodeLcmMessage(d, n, &m).ok()) return;
     occupancy = m.size;
-    octomap::OcTree tree(m.resolution > 0.0 ? m.resolution : 0.1);
-    std::istringstream in(std::string(m.data.begin(), m.data.end()));
-    if (tree.readBinary(in)) occupancy_mem = static_cast<int64_t>(tree.memoryUsage());
+    // The service's own tree (probabilities, free space): what its memory holds. The
+    // published maximum-likelihood tree is smaller and would hide growth.
+    occupancy_mem = m.memory_bytes;
   });
   bus->Subscribe(ch.perception_camera_pose, [&](const std::string&, const uint8_t* d, size_t n, int64_t) {
     mbslam::camera_pose_t m{};

@@ -395,6 +395,7 @@ SyntheticFrame SyntheticOutputs::Frame(int k) const {
       if (tree.isNodeOccupied(*it)) ++occupied;
     }
     occ.num_occupied = occupied;
+    occ.memory_bytes = static_cast<int64_t>(tree.memoryUsage());
     f.occupancy = occ;
   }
   return f;

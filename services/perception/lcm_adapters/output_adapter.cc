@@ -165,6 +165,7 @@ mbslam::occupancy_t ToLcm(const OccupancyOutput& o) {
   m.scale_state = static_cast<int8_t>(o.scale_state);
   m.resolution = o.resolution;
   m.num_occupied = o.num_occupied;
+  m.memory_bytes = o.memory_bytes;
   m.size = static_cast<int32_t>(o.octree_binary.size());
   m.data.assign(o.octree_binary.begin(), o.octree_binary.end());
   return m;

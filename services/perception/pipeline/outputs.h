@@ -110,6 +110,7 @@ struct OccupancyOutput {
   ScaleState scale_state = ScaleState::kUpToScale;
   double resolution = 0.0;
   int num_occupied = 0;
+  int64_t memory_bytes = 0;   // the probabilistic tree in memory, estimated (bytes)
   std::string octree_binary;  // octomap::OcTree::writeBinary stream
 };
 

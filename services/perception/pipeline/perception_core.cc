@@ -258,6 +258,7 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
   out.scale_state = slam_.metric() ? ScaleState::kMetric : ScaleState::kUpToScale;
   out.resolution = occupancy_->resolution();
   out.num_occupied = static_cast<int>(occupancy_->NumOccupied());
+  out.memory_bytes = occupancy_->MemoryBytes();
   if (occupancy_->Serialize(&out.octree_binary).ok()) result->occupancy = std::move(out);
 }
 
