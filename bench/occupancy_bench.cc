@@ -18,7 +18,10 @@
 
 #include <Eigen/Core>
 
+#include <octomap/OcTree.h>
+
 #include "services/perception/occupancy/occupancy_map.h"
+#include "services/perception/occupancy/octree_ops.h"
 
 namespace {
 
@@ -141,6 +144,49 @@ void BM_RescaleRebuild(benchmark::State& state) {
   state.counters["rays"] = static_cast<double>(map.num_stored_rays());
 }
 BENCHMARK(BM_RescaleRebuild)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// The memory bound's crop (occupancy.max_memory_mb): a copy of the nodes within a box
+// around the last camera of a 100-keyframe x 300-point map at 10 cm (~1.3M nodes, the
+// default 64 MB bound). Arg: half edge of the box (voxels).
+void BM_MemoryBoundCrop(benchmark::State& state) {
+  OccupancyMapOptions options = Options(0.1);
+  options.max_memory_mb = 0.0;  // unbounded: the crop is timed here
+  OccupancyMap map(options, OccupancyMap::Units::kMetres);
+  std::mt19937 rng(17);
+  Eigen::Vector3d camera = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 100; ++k) {
+    const Keyframe kf = MakeKeyframe(k, 300, 20.0, &rng);
+    map.InsertRays(kf.camera, kf.points);
+    camera = kf.camera;
+  }
+  const octomap::OcTree& tree = *map.tree();
+  octomap::OcTreeKey c;
+  if (!tree.coordToKeyChecked(octomap::point3d(static_cast<float>(camera.x()), static_cast<float>(camera.y()),
+                                               static_cast<float>(camera.z())),
+                              c)) {
+    state.SkipWithError("camera outside the tree");
+    return;
+  }
+  const int half = static_cast<int>(state.range(0));
+  const octomap::OcTreeKey lo(c[0] - half, c[1] - half, c[2] - half);
+  const octomap::OcTreeKey hi(c[0] + half, c[1] + half, c[2] + half);
+  size_t kept = 0;
+  for (auto _ : state) {
+    if (state.range(1) == 0) {
+      int64_t occupied = 0;
+      const auto crop = mbslam::CropOctree(tree, lo, hi, &occupied);
+      kept = crop->size();
+      benchmark::DoNotOptimize(occupied);
+    } else {
+      kept = mbslam::CountCropNodes(tree, lo, hi);
+    }
+  }
+  state.counters["nodes"] = static_cast<double>(tree.size());
+  state.counters["nodes_kept"] = static_cast<double>(kept);
+  state.counters["memory_mb"] = static_cast<double>(map.MemoryBytes()) / (1024.0 * 1024.0);
+}
+// Second arg: 0 copies, 1 only counts the nodes (how the box is chosen).
+BENCHMARK(BM_MemoryBoundCrop)->ArgsProduct({{64, 128}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

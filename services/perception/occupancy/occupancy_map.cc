@@ -200,12 +200,15 @@ void OccupancyMap::StoreBatch(RayBatch batch) {
   }
 }
 
+namespace {
+// Each node is a 16-byte allocation (32 with glibc's header and alignment); an inner
+// node also holds an array of 8 child pointers (80 bytes allocated), and in these trees
+// about one node in four is inner (occupancy_map_test checks the estimate).
+constexpr int64_t kBytesPerNode = 32 + 80 / 4;
+}  // namespace
+
 int64_t OccupancyMap::MemoryBytes() const {
   if (!tree_) return 0;
-  // Each node is a 16-byte allocation (32 with glibc's header and alignment); an inner
-  // node also holds an array of 8 child pointers (80 bytes allocated), and in these
-  // trees about one node in four is inner (measured, occupancy_map_test).
-  constexpr int64_t kBytesPerNode = 32 + 80 / 4;
   return static_cast<int64_t>(tree_->size()) * kBytesPerNode;
 }
 
@@ -217,29 +220,34 @@ void OccupancyMap::BoundMemory(const Eigen::Vector3d& center) {
   if (!KeyInTree(*tree_, ToOcto(center), c)) return;
   const double res = tree_->getResolution();
   const int64_t occupied_before = num_occupied_;
-  int half = options_.keep_half_edge_voxels;
-  while (true) {
-    octomap::OcTreeKey lo, hi;
+  auto box = [&c](int half, octomap::OcTreeKey* lo, octomap::OcTreeKey* hi) {
     for (int i = 0; i < 3; ++i) {
-      lo[i] = static_cast<octomap::key_type>(std::max(0, static_cast<int>(c[i]) - half));
-      hi[i] = static_cast<octomap::key_type>(std::min(65535, static_cast<int>(c[i]) + half));
+      (*lo)[i] = static_cast<octomap::key_type>(std::max(0, static_cast<int>(c[i]) - half));
+      (*hi)[i] = static_cast<octomap::key_type>(std::min(65535, static_cast<int>(c[i]) + half));
     }
-    int64_t occupied = 0;
-    tree_ = CropOctree(*tree_, lo, hi, &occupied);
-    num_occupied_ = occupied;
-    // Stored rays from outside the box would bring the dropped voxels back on a rebuild.
-    const double reach = (half + 0.5) * res;
-    for (auto it = batches_.begin(); it != batches_.end();) {
-      if (((it->origin - center).cwiseAbs().array() > reach).any()) {
-        stored_rays_ -= static_cast<int64_t>(it->ends.size());
-        rays_forgotten_ += static_cast<int64_t>(it->ends.size());
-        it = batches_.erase(it);
-      } else {
-        ++it;
-      }
-    }
-    if (static_cast<double>(MemoryBytes()) <= 0.5 * limit || half <= 1) break;
+  };
+  // The largest box (halving from keep_half_edge_voxels) whose copy is below half the
+  // bound, found by counting (a third of the cost of a copy), then one copy.
+  int half = options_.keep_half_edge_voxels;
+  octomap::OcTreeKey lo, hi;
+  while (true) {
+    box(half, &lo, &hi);
+    if (half <= 1 || static_cast<double>(CountCropNodes(*tree_, lo, hi)) * kBytesPerNode <= 0.5 * limit) break;
     half /= 2;
+  }
+  int64_t occupied = 0;
+  tree_ = CropOctree(*tree_, lo, hi, &occupied);
+  num_occupied_ = occupied;
+  // Stored rays from outside the box would bring the dropped voxels back on a rebuild.
+  const double reach = (half + 0.5) * res;
+  for (auto it = batches_.begin(); it != batches_.end();) {
+    if (((it->origin - center).cwiseAbs().array() > reach).any()) {
+      stored_rays_ -= static_cast<int64_t>(it->ends.size());
+      rays_forgotten_ += static_cast<int64_t>(it->ends.size());
+      it = batches_.erase(it);
+    } else {
+      ++it;
+    }
   }
   ++crops_;
   occupied_dropped_ += std::max<int64_t>(0, occupied_before - num_occupied_);

@@ -278,6 +278,15 @@ NodeBox ChildBox(const NodeBox& b, unsigned pos) {
   return c;
 }
 
+size_t CountSubtree(const octomap::OcTree& tree, const octomap::OcTreeNode* node) {
+  size_t n = 1;
+  if (!tree.nodeHasChildren(node)) return n;
+  for (unsigned pos = 0; pos < 8; ++pos) {
+    if (tree.nodeChildExists(node, pos)) n += CountSubtree(tree, tree.getNodeChild(node, pos));
+  }
+  return n;
+}
+
 // True when the subtree of `node` (box `b`) has a leaf overlapping the key box.
 bool HasLeafInBox(const octomap::OcTree& tree, const octomap::OcTreeNode* node, const NodeBox& b,
                   const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key) {
@@ -293,12 +302,14 @@ bool HasLeafInBox(const octomap::OcTree& tree, const octomap::OcTreeNode* node, 
 }
 
 // Copies the overlapping part of `src` (box `b`, known to hold a leaf in the key box)
-// into the existing node `dst`.
+// into the existing node `dst`; with dst_tree == nullptr only counts the nodes a copy
+// would have (`num_nodes`).
 void CopyOverlap(const octomap::OcTree& src_tree, const octomap::OcTreeNode* src, const NodeBox& b,
                  const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key, bool inside,
-                 octomap::OcTree* dst_tree, octomap::OcTreeNode* dst, int64_t* num_occupied) {
+                 octomap::OcTree* dst_tree, octomap::OcTreeNode* dst, int64_t* num_occupied, size_t* num_nodes) {
+  ++*num_nodes;
   if (!src_tree.nodeHasChildren(src)) {
-    dst->setLogOdds(src->getLogOdds());
+    if (dst != nullptr) dst->setLogOdds(src->getLogOdds());
     if (src_tree.isNodeOccupied(src)) *num_occupied += int64_t{1} << (3 * (63 - __builtin_clzll(b.span)));
     return;
   }
@@ -308,10 +319,14 @@ void CopyOverlap(const octomap::OcTree& src_tree, const octomap::OcTreeNode* src
     const NodeBox cb = ChildBox(b, pos);
     const bool child_inside = inside || Inside(cb, min_key, max_key);
     if (!child_inside && !HasLeafInBox(src_tree, child, cb, min_key, max_key)) continue;
-    octomap::OcTreeNode* d = dst_tree->createNodeChild(dst, pos);
-    CopyOverlap(src_tree, child, cb, min_key, max_key, child_inside, dst_tree, d, num_occupied);
+    if (child_inside && dst == nullptr) {
+      *num_nodes += CountSubtree(src_tree, child);
+      continue;
+    }
+    octomap::OcTreeNode* d = dst != nullptr ? dst_tree->createNodeChild(dst, pos) : nullptr;
+    CopyOverlap(src_tree, child, cb, min_key, max_key, child_inside, dst_tree, d, num_occupied, num_nodes);
   }
-  dst->updateOccupancyChildren();
+  if (dst != nullptr) dst->updateOccupancyChildren();
 }
 
 }  // namespace
@@ -327,12 +342,26 @@ std::unique_ptr<octomap::OcTree> CropOctree(const octomap::OcTree& tree, const o
   int64_t occupied = 0;
   const octomap::OcTreeNode* root = tree.getRoot();
   const NodeBox box{{0u, 0u, 0u}, 1u << kTreeDepth};
+  size_t nodes = 0;
   if (root != nullptr && HasLeafInBox(tree, root, box, min_key, max_key)) {
     CopyOverlap(tree, root, box, min_key, max_key, Inside(box, min_key, max_key), out.get(), out->CreateRoot(),
-                &occupied);
+                &occupied, &nodes);
   }
   if (num_occupied != nullptr) *num_occupied = occupied;
   return out;
+}
+
+size_t CountCropNodes(const octomap::OcTree& tree, const octomap::OcTreeKey& min_key,
+                      const octomap::OcTreeKey& max_key) {
+  const octomap::OcTreeNode* root = tree.getRoot();
+  const NodeBox box{{0u, 0u, 0u}, 1u << kTreeDepth};
+  size_t nodes = 0;
+  int64_t occupied = 0;
+  if (root != nullptr && HasLeafInBox(tree, root, box, min_key, max_key)) {
+    CopyOverlap(tree, root, box, min_key, max_key, Inside(box, min_key, max_key), nullptr, nullptr, &occupied,
+                &nodes);
+  }
+  return nodes;
 }
 
 void WriteOctreeBinary(const octomap::OcTree& tree, std::string* out) {

@@ -53,6 +53,10 @@ std::unique_ptr<octomap::OcTree> CropOctree(const octomap::OcTree& tree,
                                             const octomap::OcTreeKey& max_key,
                                             int64_t* num_occupied);
 
+// The number of nodes CropOctree(tree, min_key, max_key) would have, without copying.
+size_t CountCropNodes(const octomap::OcTree& tree, const octomap::OcTreeKey& min_key,
+                      const octomap::OcTreeKey& max_key);
+
 // Appends to `out` exactly what `octomap::OcTree copy(tree); copy.writeBinary(stream)`
 // would write.
 void WriteOctreeBinary(const octomap::OcTree& tree, std::string* out);

@@ -213,6 +213,7 @@ TEST(OctreeOps, CropToEverythingIsTheSameTree) {
   const auto copy = CropOctree(tree, octomap::OcTreeKey(0, 0, 0), octomap::OcTreeKey(65535, 65535, 65535), &occupied);
   EXPECT_EQ(OurWriteBinary(*copy), OurWriteBinary(tree));
   EXPECT_EQ(copy->size(), tree.size());
+  EXPECT_EQ(CountCropNodes(tree, octomap::OcTreeKey(0, 0, 0), octomap::OcTreeKey(65535, 65535, 65535)), tree.size());
   EXPECT_EQ(copy->getNumLeafNodes(), tree.getNumLeafNodes());
   EXPECT_EQ(occupied, CountOccupied(tree));
   EXPECT_EQ(copy->memoryUsage(), tree.memoryUsage());
@@ -237,6 +238,7 @@ TEST(OctreeOps, CropKeepsTheBoxAndDropsTheRest) {
   const auto crop = CropOctree(tree, lo, hi, &occupied);
   EXPECT_LT(crop->size(), tree.size());
   EXPECT_GT(crop->size(), 0u);
+  EXPECT_EQ(CountCropNodes(tree, lo, hi), crop->size());
   EXPECT_EQ(occupied, CountOccupied(*crop));
   // Inside the box: the same value at the finest resolution as the original.
   std::mt19937 rng(5);
