@@ -1,5 +1,8 @@
 #include "services/perception/pipeline/perception_core.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <future>
@@ -667,6 +670,9 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   if (!person_boxes.empty()) {
     // frame.gray is not written after decoding; the job holds a reference to it.
     person_job_ = std::async(std::launch::async, [this, gray = frame.gray, boxes = std::move(person_boxes)] {
+      // Below the per-image threads (the next image's KLT runs on both cores meanwhile);
+      // raising niceness is always permitted, a failure only keeps the default.
+      if (options_.person.job_nice > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), options_.person.job_nice);
       std::vector<std::pair<int, bool>> found;
       for (const auto& [id, box] : boxes) found.emplace_back(id, person_detector_.Detect(gray, box));
       return found;

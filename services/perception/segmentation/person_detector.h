@@ -24,6 +24,7 @@ struct PersonDetectorOptions {
   int max_box_height_px = 192;     // larger regions are scaled down to this height first (px; bounds the cost)
   double scale_step = 1.05;        // HOG pyramid step between detection scales
   int max_checks_per_frame = 1;    // objects checked per image at most, least recently checked first (count)
+  int job_nice = 10;               // niceness of the thread the service runs the checks in (0-19)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GE(every_n_frames, 1);
@@ -33,6 +34,7 @@ struct PersonDetectorOptions {
     MBSLAM_CHECK_OPTION_GE(max_box_height_px, 128);
     MBSLAM_CHECK_OPTION(scale_step > 1.0 && scale_step <= 2.0);
     MBSLAM_CHECK_OPTION_GE(max_checks_per_frame, 1);
+    MBSLAM_CHECK_OPTION(job_nice >= 0 && job_nice <= 19);
     return true;
   }
   template <typename V>
@@ -46,6 +48,8 @@ struct PersonDetectorOptions {
     v("max_box_height_px", &max_box_height_px, "larger regions are scaled down to this height first (px)");
     v("scale_step", &scale_step, "HOG pyramid step between detection scales");
     v("max_checks_per_frame", &max_checks_per_frame, "objects checked per image at most, least recently checked first");
+    v("job_nice", &job_nice,
+      "niceness of the thread the checks run in, one image behind (0-19; tracking's threads go first)");
   }
 };
 
