@@ -72,6 +72,7 @@ struct PerceptionOptions {
     c.objects = objects;
     // Lockstep replays must be deterministic: bundle adjustment runs inline there.
     if (pipeline.lockstep()) c.slam.background_ba = false;
+    c.wait_for_person_checks = pipeline.lockstep();
     return c;
   }
 

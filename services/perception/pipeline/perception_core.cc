@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <future>
 #include <limits>
@@ -572,8 +573,9 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   }
 
   // Person checks run on the other core, one image behind: the checks launched with the
-  // previous image are collected here (waiting if they are not done, so that the result
-  // is the same in every mode), and this image's are launched after its hulls.
+  // previous image are collected here (in lockstep waiting if they are not done, so that
+  // the result is the same every run; live only when done), and this image's are
+  // launched after its hulls when no job is running.
   {
     ScopedStageTimer timer(person_timer_);
     CollectPersonChecks();
@@ -582,7 +584,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   // checked first (a burst of new objects would otherwise stall one image).
   std::set<int> person_check_due;
   std::vector<std::pair<int, cv::Rect>> person_boxes;
-  if (options_.person.enabled) {
+  if (options_.person.enabled && !person_job_.valid()) {
     std::vector<std::pair<int64_t, int>> due;  // (last check frame, object id)
     for (const SegmentedObject& o : seg.objects) {
       if (o.hull.size() < 3) continue;
@@ -709,6 +711,10 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
 
 void PerceptionCore::CollectPersonChecks() {
   if (!person_job_.valid()) return;
+  if (!options_.wait_for_person_checks &&
+      person_job_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+    return;  // live: still running (niced); taken with a later image
+  }
   for (const auto& [id, found] : person_job_.get()) {
     auto it = object_records_.find(id);  // forgotten meanwhile: nothing to mark
     if (found && it != object_records_.end()) it->second.is_person = true;

@@ -108,6 +108,10 @@ struct CoreOptions {
   int64_t occupancy_publish_period_us = 1000000;  // PERCEPTION_OCCUPANCY at most this often, at keyframes (µs)
   ObjectTrackingOptions objects;
   int map_publish_every_frames = 15;  // PERCEPTION_MAP at most this often, and at every keyframe
+  // Person checks launched with one image are collected with the next: waiting for them
+  // (lockstep: the same result every run) or, live, taking them when done and launching
+  // no new ones meanwhile (the niced job never stalls an image).
+  bool wait_for_person_checks = true;
   double ground_depth_margin = 0.15;  // depth bound from the ground: static points lie above it (fraction)
   double ground_min_elevation_deg = 3.0;  // rays closer to the horizon get no ground bound (deg)
   double ground_tilt_sigma_deg = 2.0;     // assumed error of the plane's tilt, widening the bound near the horizon (deg)
