@@ -121,6 +121,10 @@ Status ReadObjectsLog(const std::string& path, const std::string& channel,
     for (const auto& o : msg.objects) {
       ObjectEstimate& est = (*objects)[o.id];
       est.id = o.id;
+      // An object published from the segmentation alone (no filter yet: no particles, no
+      // volumes) has an id and a hull but no position: its zero position is not an
+      // estimate and is not scored.
+      if (o.num_particles <= 0 && o.volumes.empty()) continue;
       ObjectSample s;
       s.utime = msg.utime;
       s.position = Eigen::Vector3d(o.position[0], o.position[1], o.position[2]);

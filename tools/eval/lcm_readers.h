@@ -30,7 +30,9 @@ struct GroundTruthLog {
 };
 Status ReadGroundTruthLog(const std::string& path, const std::string& channel, GroundTruthLog* log);
 
-// Objects by id, one sample per objects_t message in which they appear.
+// Objects by id, one sample per objects_t message in which they appear with an estimate
+// (an object without particles or volumes is listed without a sample: its position is
+// not given).
 Status ReadObjectsLog(const std::string& path, const std::string& channel,
                       std::map<int, ObjectEstimate>* objects, int* num_messages = nullptr);
 

@@ -87,7 +87,12 @@ TEST(LcmReaders, CameraPosesGroundTruthAndObjects) {
       o.volumes.push_back(v);
       o.num_volumes = 1;
       objs.objects.push_back(o);
-      objs.num_objects = 1;
+      // Detected from the segmentation only: an id and a hull, no position.
+      mbslam::object_t detected{};
+      detected.id = 13;
+      detected.orientation[0] = 1.0;
+      objs.objects.push_back(detected);
+      objs.num_objects = 2;
       ASSERT_TRUE(log->Write("PERCEPTION_OBJECTS", t, objs).ok());
     }
   }
@@ -117,6 +122,8 @@ TEST(LcmReaders, CameraPosesGroundTruthAndObjects) {
   ASSERT_EQ(objects.count(12), 1u);
   EXPECT_EQ(objects.at(12).samples.size(), 20u);
   EXPECT_EQ(objects.at(12).samples[3].volumes.size(), 1u);
+  ASSERT_EQ(objects.count(13), 1u);
+  EXPECT_TRUE(objects.at(13).samples.empty());
   ObjectMetricsOptions options;
   options.horizon_us = 300000;
   ObjectsEvaluation r;
