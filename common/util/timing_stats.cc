@@ -31,6 +31,7 @@ void TimingStats::Add(double duration_ms) {
   }
   ++count_;
   ++total_count_;
+  last_ = duration_ms;
   sum_ += duration_ms;
   max_ = std::max(max_, duration_ms);
   if (budget_ms_ > 0.0 && duration_ms > budget_ms_) {
@@ -90,6 +91,11 @@ TimingSummary TimingStats::Drain() {
 int64_t TimingStats::total_count() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return total_count_;
+}
+
+double TimingStats::last_ms() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_;
 }
 
 }  // namespace mbslam

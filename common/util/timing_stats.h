@@ -34,6 +34,8 @@ class TimingStats {
   TimingSummary Cumulative() const;
   // Totals since construction (not reset by Drain).
   int64_t total_count() const;
+  // The latest duration added (ms); 0 before the first.
+  double last_ms() const;
   const std::string& name() const { return name_; }
   double budget_ms() const { return budget_ms_; }
 
@@ -48,6 +50,7 @@ class TimingStats {
   int64_t overruns_ = 0;
   double sum_ = 0.0;
   double max_ = 0.0;
+  double last_ = 0.0;
   int64_t total_count_ = 0;
   // Run-long sample: every `stride_`-th duration, the stride doubling when full.
   std::vector<double> all_;

@@ -58,6 +58,10 @@ void PerceptionPipeline::Start() {
   if (started_) return;
   started_ = true;
   period_start_wall_ = WallUtime();
+  if (!options_.timing_log.empty()) {
+    timing_log_.open(options_.timing_log, std::ios::trunc);
+    if (!timing_log_) MBSLAM_LOG(WARNING) << "timing log " << options_.timing_log << ": cannot open; not written";
+  }
   decode_thread_ = std::thread([this] { DecodeLoop(); });
   process_thread_ = std::thread([this] { ProcessLoop(); });
 }
@@ -132,6 +136,7 @@ void PerceptionPipeline::DrainOdometry() {
 }
 
 void PerceptionPipeline::ProcessImage(const ImageFrame& frame) {
+  const int64_t start_wall = WallUtime();
   FrameResult result;
   {
     ScopedStageTimer timer(frame_timer_);
@@ -144,9 +149,32 @@ void PerceptionPipeline::ProcessImage(const ImageFrame& frame) {
     sink_->OnFrameResult(result);
   }
   ++frames_processed_;
+  const int64_t end_wall = WallUtime();
   if (frame.receive_wall_utime > 0) {
-    latency_.Add(UtimeToMs(WallUtime() - frame.receive_wall_utime));
+    latency_.Add(UtimeToMs(end_wall - frame.receive_wall_utime));
   }
+  if (timing_log_.is_open()) WriteTimingLine(frame, start_wall, end_wall);
+}
+
+void PerceptionPipeline::WriteTimingLine(const ImageFrame& frame, int64_t start_wall_utime, int64_t end_wall_utime) {
+  if (timing_log_stages_.empty()) {
+    timing_log_stages_ = timers_->All();
+    timing_log_counts_.assign(timing_log_stages_.size(), 0);
+    timing_log_ << "seq,utime,wait_ms";
+    for (const TimingStats* s : timing_log_stages_) timing_log_ << "," << s->name() << "_ms";
+    timing_log_ << ",latency_ms\n";
+  }
+  const bool received = frame.receive_wall_utime > 0;
+  timing_log_ << frame.seq << "," << frame.utime << ","
+              << (received ? UtimeToMs(start_wall_utime - frame.receive_wall_utime) : 0.0);
+  // A stage that did not run in this image (or, for a back-end stage, did not finish
+  // during it) is written as 0.
+  for (size_t i = 0; i < timing_log_stages_.size(); ++i) {
+    const int64_t count = timing_log_stages_[i]->total_count();
+    timing_log_ << "," << (count != timing_log_counts_[i] ? timing_log_stages_[i]->last_ms() : 0.0);
+    timing_log_counts_[i] = count;
+  }
+  timing_log_ << "," << (received ? UtimeToMs(end_wall_utime - frame.receive_wall_utime) : 0.0) << "\n";
 }
 
 void PerceptionPipeline::CountTrackingTransition(TrackingState state) {

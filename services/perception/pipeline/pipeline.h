@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <thread>
@@ -101,6 +102,8 @@ class PerceptionPipeline {
   void ProcessLoop();
   void DrainOdometry();
   void ProcessImage(const ImageFrame& frame);
+  // One line of the timing log (options_.timing_log) for the image just processed.
+  void WriteTimingLine(const ImageFrame& frame, int64_t start_wall_utime, int64_t end_wall_utime);
   // Counts the camera tracking state leaving / regaining OK (processing thread).
   void CountTrackingTransition(TrackingState state);
 
@@ -113,6 +116,10 @@ class PerceptionPipeline {
   TimingStats* publish_timer_;  // the sink (encoding, publishing, recording) per image
   TimingStats* frame_timer_;
   TimingStats latency_;
+  // Timing log (processing thread): the stages' columns are fixed at the first image.
+  std::ofstream timing_log_;
+  std::vector<TimingStats*> timing_log_stages_;
+  std::vector<int64_t> timing_log_counts_;
 
   BoundedQueue<InputEvent> input_queue_;
   BoundedQueue<FrameEvent> frame_queue_;

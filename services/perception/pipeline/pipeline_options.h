@@ -18,6 +18,7 @@ struct PipelineOptions {
   int64_t status_period_us = 1000000;   // PERCEPTION_STATUS period in message time (µs)
   int64_t stall_timeout_us = 2000000;   // no image for this long (wall) = STALLED (µs)
   double frame_budget_ms = 33.3;        // per-frame processing budget; overruns are counted (ms)
+  std::string timing_log;               // per-image timing CSV written here ("" = none)
 
   bool lockstep() const { return mode == "lockstep"; }
 
@@ -45,6 +46,8 @@ struct PipelineOptions {
     v("status_period_us", &status_period_us, "PERCEPTION_STATUS period in message time (us)");
     v("stall_timeout_us", &stall_timeout_us, "no image for this long (wall) means STALLED (us)");
     v("frame_budget_ms", &frame_budget_ms, "per-frame processing budget (ms)");
+    v("timing_log", &timing_log,
+      "per-image timing CSV: seq, utime, queue wait, each stage's time in that image, latency (\"\" = none)");
   }
 };
 
