@@ -496,6 +496,13 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   UpdateOccupancy(map_update, frame.utime, &result);
   if (map_update.rescaled_by && ground_) ground_->Rescale(*map_update.rescaled_by);
   FillCameraPose(slam_pose, &result.camera_pose);
+  for (const auto& [f, cam_from_world] : slam_pose.backfilled) {
+    auto u = frame_utime_.find(f);
+    if (u == frame_utime_.end()) continue;
+    Rigid3d world_from_cam = cam_from_world.Inverse();
+    if (map_update.rescaled_by) world_from_cam.translation *= *map_update.rescaled_by;
+    result.backfilled_camera_poses.emplace_back(u->second, world_from_cam);
+  }
   result.world_rescaled_by = map_update.rescaled_by;
   if (map_update.rescaled_by && result.camera_pose.tracking_state != TrackingState::kNotInitialized) {
     // This image's pose was computed before the rescale.

@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
 
@@ -30,6 +31,15 @@ void ResultRecorder::OnFrameResult(const FrameResult& r) {
     for (auto& [id, poses] : objects_) {
       for (TimedPose& p : poses) p.pose.translation *= *r.world_rescaled_by;
     }
+  }
+  // Poses recovered for earlier images (in time order, all before this image): inserted
+  // in order, an image already in the trajectory is not repeated.
+  for (const auto& [utime, world_from_cam] : r.backfilled_camera_poses) {
+    auto at = std::lower_bound(camera_.begin(), camera_.end(), utime,
+                               [](const TimedPose& p, int64_t t) { return p.utime < t; });
+    if (at != camera_.end() && at->utime == utime) continue;
+    camera_.insert(at, TimedPose{utime, world_from_cam});
+    ++backfilled_;
   }
   const TrackingState s = r.camera_pose.tracking_state;
   if (s == TrackingState::kOk || s == TrackingState::kRelocalized) {
@@ -101,6 +111,8 @@ Status ResultRecorder::Write(const std::string& dir, const std::string& extra_su
   std::ostringstream json;
   json << "{\n  \"frames\": " << frames_ << ",\n  \"frames_tracked\": " << tracked_
        << ",\n  \"tracked_fraction\": " << (frames_ ? double(tracked_) / frames_ : 0.0)
+       << ",\n  \"frames_backfilled\": " << backfilled_
+       << ",\n  \"posed_fraction\": " << (frames_ ? double(tracked_ + backfilled_) / frames_ : 0.0)
        << ",\n  \"first_utime\": " << first_utime_ << ",\n  \"last_utime\": " << last_utime_
        << ",\n  \"objects_with_trajectory\": " << objects_.size()
        << ",\n  \"map_points\": " << (map_ ? map_->points.size() : 0)

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <sstream>
+#include <vector>
+
 #include "common/util/atomic_file.h"
 
 namespace mbslam {
@@ -35,6 +38,48 @@ TEST(ResultRecorder, WritesTrackedPosesAndSummary) {
   EXPECT_EQ(lines, 4);  // header + 3 tracked
   EXPECT_NE(summary.find("\"tracked_fraction\": 0.75"), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"note\": 1"), std::string::npos);
+}
+
+TEST(ResultRecorder, BackfilledPosesGoInTimeOrder) {
+  ResultRecorder recorder;
+  // Images 0-3 without a pose; image 4 confirms a map and brings poses for 0-3 (1 lost).
+  for (int i = 0; i < 6; ++i) {
+    FrameResult r;
+    r.utime = 1000000 + i * 100000;
+    r.camera_pose.utime = r.utime;
+    r.camera_pose.tracking_state = i < 4 ? TrackingState::kInitializing : TrackingState::kOk;
+    r.camera_pose.world_from_cam.translation.x() = i;
+    if (i == 4) {
+      for (int k : {0, 2, 3}) {
+        Rigid3d p;
+        p.translation.x() = k;
+        r.backfilled_camera_poses.emplace_back(1000000 + k * 100000, p);
+      }
+    }
+    if (i == 5) {  // a repeated image is not written twice
+      r.backfilled_camera_poses.emplace_back(1000000 + 3 * 100000, Rigid3d());
+    }
+    recorder.OnFrameResult(r);
+  }
+  char pattern[] = "/tmp/mbslam_rec_XXXXXX";
+  const std::string dir = mkdtemp(pattern);
+  ASSERT_TRUE(recorder.Write(dir, "").ok());
+  std::string traj, summary;
+  ASSERT_TRUE(ReadFileToString(dir + "/camera_trajectory.tum", &traj).ok());
+  ASSERT_TRUE(ReadFileToString(dir + "/summary.json", &summary).ok());
+  std::istringstream in(traj);
+  std::string line;
+  std::vector<double> x;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double t, tx;
+    fields >> t >> tx;
+    x.push_back(tx);
+  }
+  EXPECT_EQ(x, (std::vector<double>{0, 2, 3, 4, 5}));
+  EXPECT_NE(summary.find("\"tracked_fraction\": 0.333"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"frames_backfilled\": 3"), std::string::npos) << summary;
 }
 
 TEST(ResultRecorder, TrajectoriesAreBoundedOldestDropped) {

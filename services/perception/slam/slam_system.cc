@@ -74,6 +74,7 @@ void SlamSystem::Reset() {
   lost_frames_ = 0;
   metric_ = false;
   confirm_count_ = 0;
+  unposed_.clear();
 }
 
 Status SlamSystem::SaveMap(const std::string& path) {
@@ -180,6 +181,11 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   if (state_ == SlamState::kNotInitialized || state_ == SlamState::kInitializing) {
     TryInitialize(frame, &out);
     last_frame_ = frame.frame_index;
+    if (out.valid) {
+      BackfillPoses(frame.frame_index, &out);
+    } else {
+      RememberUnposed(frame);
+    }
     return out;
   }
   // Tracking: 2D-3D correspondences through the tracks that observe map points and
@@ -225,9 +231,12 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     if (ratio < options_.init_confirm_inlier_ratio) {
       MBSLAM_LOG(INFO) << "SLAM: new map not confirmed (inlier share " << ratio << "); retrying";
       const std::optional<Bridge> keep = bridge_;
+      auto unposed = std::move(unposed_);
       Reset();
       bridge_ = keep;
+      unposed_ = std::move(unposed);
       out.state = state_;
+      RememberUnposed(frame);
       return out;
     }
     if (++confirm_count_ >= options_.init_confirm_frames) {
@@ -235,6 +244,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
       bridge_.reset();
       out.relocalized = just_initialized_;
       MBSLAM_LOG(INFO) << "SLAM: map confirmed (" << map_.num_points() << " points)";
+      BackfillPoses(frame.frame_index, &out);
     }
   }
   if (good) {
@@ -273,8 +283,10 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     ++lost_frames_;
     if (state_ == SlamState::kConfirming) {
       const std::optional<Bridge> keep = bridge_;
+      auto unposed = std::move(unposed_);
       Reset();
       bridge_ = keep;
+      unposed_ = std::move(unposed);
     } else {
       state_ = SlamState::kLost;
       if (lost_frames_ >= options_.lost_frames_to_reinit) {
@@ -291,8 +303,10 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
           b.metric = metric_;
           bridge = b;
         }
+        auto unposed = std::move(unposed_);
         Reset();
         bridge_ = bridge;
+        unposed_ = std::move(unposed);
         just_initialized_ = true;
       }
     }
@@ -301,7 +315,52 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   out.metric = metric_;
   out.scale_to_metric = metric_ ? 1.0 : 0.0;
   last_frame_ = frame.frame_index;
+  if (!out.valid) RememberUnposed(frame);
   return out;
+}
+
+void SlamSystem::RememberUnposed(const SlamFrame& frame) {
+  if (options_.backfill_max_frames <= 0) return;
+  auto& obs = unposed_[frame.frame_index];
+  obs.clear();
+  // Every track: only those that become static map points are used, whatever their
+  // label was then (the first images have no labels yet).
+  for (const SlamObservation& o : frame.observations) obs.emplace_back(o.track_id, o.xy);
+  while (static_cast<int>(unposed_.size()) > options_.backfill_max_frames) unposed_.erase(unposed_.begin());
+}
+
+void SlamSystem::BackfillPoses(int64_t frame, SlamPose* out) {
+  for (const auto& [f, obs] : unposed_) {
+    if (f >= frame) break;
+    // Images of the initialisation and confirmation already have poses in the new map.
+    if (const std::optional<Rigid3d> known = PoseOf(f)) {
+      out->backfilled.emplace_back(f, *known);
+      continue;
+    }
+    // Others are resected against the new map through their tracks' points.
+    std::vector<Eigen::Vector3d> X;
+    std::vector<Eigen::Vector2d> xy;
+    for (const auto& [track, x] : obs) {
+      const int64_t pid = map_.PointOfTrack(track);
+      if (pid < 0) continue;
+      X.push_back(map_.point(pid)->position);
+      xy.push_back(x);
+    }
+    if (X.size() < 6) {
+      MBSLAM_LOG(DEBUG) << "SLAM backfill of frame " << f << ": " << obs.size() << " observations, "
+                        << X.size() << " with points: too few";
+      continue;
+    }
+    const PoseEstimate est = EstimatePose(X, xy, focal_px_, std::nullopt, options_.pose);
+    MBSLAM_LOG(DEBUG) << "SLAM backfill of frame " << f << ": " << obs.size() << " observations, " << X.size()
+                      << " with points, " << est.num_inliers << " inliers" << (est.ok ? "" : " (failed)");
+    if (est.ok && est.num_inliers >= options_.min_tracking_inliers) out->backfilled.emplace_back(f, est.cam_from_world);
+  }
+  if (!out->backfilled.empty()) {
+    MBSLAM_LOG(INFO) << "SLAM: poses of " << out->backfilled.size() << " of " << unposed_.size()
+                     << " earlier images recovered against the new map";
+  }
+  unposed_.clear();
 }
 
 void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {

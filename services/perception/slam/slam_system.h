@@ -56,6 +56,10 @@ struct SlamOptions {
   double init_min_coverage = 0.3;        // the static world's inliers, and its points with parallax, must hold this share of the image's feature cells
   double init_max_hull_share = 0.5;      // an initialisation with more of its inliers inside moving hulls is refused
   int init_confirm_frames = 3;           // frames the new map must track well before it is trusted (frames)
+  // Images without a pose (before and during initialisation, while lost) are kept this
+  // many at most; when a map is confirmed their poses are recovered against it (the
+  // trajectory files include them; the live pose stream cannot) (frames, <= 60; 0 = off).
+  int backfill_max_frames = 60;
   double init_confirm_inlier_ratio = 0.7;  // inlier share required while confirming
   double triangulation_min_angle_deg = 1.0;  // new points need this parallax (deg)
   double triangulation_max_error_px = 2.0;   // ... and this reprojection error in both views (px)
@@ -95,6 +99,7 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION(init_min_coverage >= 0.0 && init_min_coverage <= 1.0);
     MBSLAM_CHECK_OPTION(init_max_hull_share >= 0.0 && init_max_hull_share <= 1.0);
     MBSLAM_CHECK_OPTION_GE(init_confirm_frames, 0);
+    MBSLAM_CHECK_OPTION(backfill_max_frames >= 0 && backfill_max_frames <= 60);
     MBSLAM_CHECK_OPTION(init_confirm_inlier_ratio > 0.0 && init_confirm_inlier_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GT(triangulation_min_angle_deg, 0.0);
     MBSLAM_CHECK_OPTION_GT(triangulation_max_error_px, 0.0);
@@ -125,6 +130,9 @@ struct SlamOptions {
     v("init_min_coverage", &init_min_coverage, "image feature cells the static world's inliers and its points with parallax must hold (share)");
     v("init_max_hull_share", &init_max_hull_share, "inliers inside moving hulls above this share: initialisation refused");
     v("init_confirm_frames", &init_confirm_frames, "frames a new map must track well (frames)");
+    v("backfill_max_frames", &backfill_max_frames,
+      "images without a pose kept to recover their poses once a map is confirmed, for the trajectory "
+      "files (frames, <= 60; 0 = off)");
     v("init_confirm_inlier_ratio", &init_confirm_inlier_ratio, "inlier share while confirming");
     v("triangulation_min_angle_deg", &triangulation_min_angle_deg, "parallax of new points (deg)");
     v("triangulation_max_error_px", &triangulation_max_error_px, "reprojection error of new points (px)");
@@ -193,6 +201,9 @@ struct SlamPose {
   // the tracker adopts them as tracks and hands the ids back (AssociateTrack).
   std::vector<std::pair<int64_t, Eigen::Vector2f>> refound;
   int num_refound = 0;
+  // When a map was confirmed with this image: poses of earlier images that had none
+  // (frame index, cam_from_world), recovered against the new map; in frame order.
+  std::vector<std::pair<int64_t, Rigid3d>> backfilled;
 };
 
 
@@ -287,6 +298,12 @@ class SlamSystem {
     Rigid3d cam_from_anchor;    // cam_from_world * anchor.cam_from_world^-1
   };
   std::map<int64_t, FramePose> recent_poses_;
+  // Observations (track id, normalised xy) of recent images without a valid pose,
+  // for BackfillPoses; bounded by options_.backfill_max_frames.
+  std::map<int64_t, std::vector<std::pair<int64_t, Eigen::Vector2d>>> unposed_;
+  void RememberUnposed(const SlamFrame& frame);
+  // A map was just confirmed with `frame`: poses of the unposed images before it.
+  void BackfillPoses(int64_t frame, SlamPose* out);
   void StorePose(int64_t frame, const Rigid3d& cam_from_world, const Matrix6d& covariance);
   // The current estimate of a recent frame's pose (following its anchor keyframe).
   std::optional<Rigid3d> PoseOf(int64_t frame) const;

@@ -1,0 +1,99 @@
+// Poses of the images before a map exists (initialisation, confirmation) are recovered
+// against the new map once it is confirmed (SlamOptions::backfill_max_frames).
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+
+#include "services/perception/slam/slam_system.h"
+
+namespace mbslam {
+namespace {
+
+constexpr double kFocal = 500.0;
+
+// A static scene seen by a camera sliding along x at 4 cm per image (cam_from_world of
+// image f: translation (-0.04 f, 0, 0)); images 0 and 1 have no labels yet.
+struct Scene {
+  std::vector<Eigen::Vector3d> points;
+  explicit Scene(unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> ux(-0.6, 0.6), uy(-0.45, 0.45), uz(4.0, 10.0);
+    for (int i = 0; i < 300; ++i) {
+      const double z = uz(rng);
+      points.emplace_back(ux(rng) * z, uy(rng) * z, z);
+    }
+  }
+  static Eigen::Vector3d Center(int f) { return Eigen::Vector3d(0.04 * f, 0.0, 0.0); }
+  SlamFrame Frame(int f) const {
+    SlamFrame frame;
+    frame.frame_index = f;
+    frame.utime = f * 33333;
+    frame.focal_px = kFocal;
+    for (size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3d p = points[i] - Center(f);
+      SlamObservation o;
+      o.track_id = static_cast<int64_t>(i);
+      o.xy = p.hnormalized();
+      o.uv = o.xy * kFocal + Eigen::Vector2d(320.0, 240.0);
+      o.body_id = f < 2 ? -1 : 0;
+      o.p_static = f < 2 ? 0.5 : 0.9;
+      frame.observations.push_back(o);
+    }
+    return frame;
+  }
+};
+
+TEST(SlamBackfill, EarlierImagesGetTheirPosesWhenTheMapIsConfirmed) {
+  const Scene scene(3);
+  SlamOptions options;
+  options.background_ba = false;
+  SlamSystem slam(options);
+  std::map<int64_t, Rigid3d> live, backfilled;
+  int confirmed_at = -1;
+  for (int f = 0; f < 30; ++f) {
+    const SlamFrame frame = scene.Frame(f);
+    const SlamPose pose = slam.TrackPose(frame);
+    if (pose.valid) live[f] = pose.cam_from_world;
+    if (!pose.backfilled.empty()) {
+      EXPECT_EQ(confirmed_at, -1) << "backfilled twice";
+      confirmed_at = f;
+      for (const auto& [g, T] : pose.backfilled) backfilled[g] = T;
+    }
+    std::unordered_map<int64_t, int> labels;
+    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
+    slam.UpdateMap(frame, labels);
+  }
+  ASSERT_GT(confirmed_at, 2);
+  // Every image before the first live pose is back-filled, none twice.
+  for (int f = 0; f < confirmed_at; ++f) {
+    EXPECT_EQ(live.count(f), 0u) << f;
+    EXPECT_EQ(backfilled.count(f), 1u) << f;
+  }
+  for (const auto& [f, T] : backfilled) EXPECT_LT(f, confirmed_at);
+  // In the map's gauge (image 0 at the origin, unknown scale) the camera centres lie on
+  // the true line at distances proportional to the truth.
+  const double scale = (live.at(confirmed_at).Inverse().translation).x() / Scene::Center(confirmed_at).x();
+  ASSERT_GT(scale, 0.0);
+  for (const auto& [f, T] : backfilled) {
+    const Eigen::Vector3d c = T.Inverse().translation / scale;
+    EXPECT_NEAR((c - Scene::Center(static_cast<int>(f))).norm(), 0.0, 0.01) << "image " << f;
+  }
+}
+
+TEST(SlamBackfill, OffKeepsOnlyLivePoses) {
+  const Scene scene(4);
+  SlamOptions options;
+  options.background_ba = false;
+  options.backfill_max_frames = 0;
+  SlamSystem slam(options);
+  for (int f = 0; f < 30; ++f) {
+    const SlamFrame frame = scene.Frame(f);
+    EXPECT_TRUE(slam.TrackPose(frame).backfilled.empty());
+    slam.UpdateMap(frame, {});
+  }
+}
+
+}  // namespace
+}  // namespace mbslam
