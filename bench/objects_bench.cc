@@ -13,6 +13,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "common/util/parallel_for.h"
+
 #include <array>
 #include <memory>
 #include <vector>
@@ -90,6 +92,7 @@ void Reset(int particles, bool sfm, Filters* f) {
 void RunFilters(benchmark::State& state, bool outputs) {
   const int particles = static_cast<int>(state.range(0));
   const bool sfm = state.range(1) != 0;
+  const int threads = static_cast<int>(state.range(2));
   const Scene& scene = Scenes();
   const size_t frames = scene.sequences[0].frames.size();
   Filters f;
@@ -100,7 +103,8 @@ void RunFilters(benchmark::State& state, bool outputs) {
       Reset(particles, sfm, &f);
       state.ResumeTiming();
     }
-    for (size_t i = 0; i < scene.sequences.size(); ++i) {
+    // The objects' filters are independent: ObjectTracking runs them on objects.threads.
+    mbslam::ParallelFor(scene.sequences.size(), threads, [&](size_t i) {
       const mbslam::BotSimFrame& frame = scene.sequences[i].frames[f.frame];
       benchmark::DoNotOptimize(frame.visible ? f.trackers[i]->Update(frame.observation).ok()
                                              : f.trackers[i]->Predict(frame.utime).ok());
@@ -111,11 +115,12 @@ void RunFilters(benchmark::State& state, bool outputs) {
                                               scene.sequences[i].ground_plane.plane.normal));
         benchmark::DoNotOptimize(f.trackers[i]->PredictVolumes(f.extents[i].extent()));
       }
-    }
+    });
     ++f.frame;
   }
   state.counters["objects"] = static_cast<double>(scene.sequences.size());
   state.counters["particles"] = particles;
+  state.counters["threads"] = threads;
 }
 
 void BM_FiveObjectsUpdate(benchmark::State& state) { RunFilters(state, false); }
@@ -124,15 +129,16 @@ void BM_FiveObjectsUpdateAndOutputs(benchmark::State& state) { RunFilters(state,
 // Args: particles per object, SfM feedback on (objects reconstructed) or off (only tracked:
 // the sampled motion model with the depth bound, ground plane and size bound).
 BENCHMARK(BM_FiveObjectsUpdate)
-    ->ArgNames({"particles", "sfm"})
-    ->Args({1000, 1})
-    ->Args({1000, 0})
-    ->Args({500, 0})
+    ->ArgNames({"particles", "sfm", "threads"})
+    ->Args({1000, 1, 1})
+    ->Args({1000, 0, 1})
+    ->Args({500, 0, 1})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FiveObjectsUpdateAndOutputs)
-    ->ArgNames({"particles", "sfm"})
-    ->Args({1000, 1})
-    ->Args({1000, 0})
+    ->ArgNames({"particles", "sfm", "threads"})
+    ->Args({1000, 1, 1})
+    ->Args({1000, 0, 1})
+    ->Args({1000, 0, 2})
     ->Unit(benchmark::kMillisecond);
 
 void BM_GroundPlaneRansac(benchmark::State& state) {

@@ -1,5 +1,7 @@
 #include "services/perception/objects/object_tracking.h"
 
+#include "common/util/parallel_for.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -318,6 +320,21 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
   }
 
   std::map<int, bool> seen;  // persistent ids observed in this image
+  // One object's filter step of this image (associated here, run below in parallel).
+  struct FilterJob {
+    int id = 0;
+    State* state = nullptr;
+    int segment_id = 0;
+    Eigen::Vector2d ref = Eigen::Vector2d::Zero();
+    std::vector<Eigen::Vector2d> track_xy;
+    BotObservation observation;
+    bool from_static = false;
+    std::optional<Eigen::Vector3d> start_point;  // previously static: start at this point
+    bool was_initialized = false;
+    Status status;
+  };
+  std::vector<FilterJob> jobs;
+  jobs.reserve(parts.size());
   for (const auto& [id, ps] : parts) {
     // One observation of the object from all its parts (the largest part first).
     ObjectObservation o = *ps.front();
@@ -349,7 +366,13 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
     if (restarted && s.filter.initialized()) ++stats_.reference_restarts;
     s.reference_xy = ref;
 
-    BotObservation b;
+    FilterJob job;
+    job.id = id;
+    job.state = &s;
+    job.segment_id = o.id;
+    job.ref = ref;
+    job.track_xy = o.track_xy;
+    BotObservation& b = job.observation;
     b.utime = frame.utime;
     b.cam_from_world = frame.cam_from_world;
     b.focal_px = frame.focal_px;
@@ -359,65 +382,83 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
     if (o.background_depth && std::isfinite(o.background_depth->max)) {
       b.depth_bound = DepthRange{0.0, o.background_depth->max * (1.0 + options_.depth_bound_margin)};
     }
-    Status st;
-    bool from_static = false;
     if (!s.filter.initialized()) {
-      from_static =
+      job.from_static =
           !o.mapped_points.empty() &&
           static_cast<double>(o.mapped_points.size()) >= options_.static_point_min_share * o.track_ids.size();
-      if (from_static) {
+      if (job.from_static) {
         // Sec. 5.1.2: a previously static object starts at its known depth. The reference
         // bearing is the centroid: its point is placed at the mapped points' median depth.
         std::vector<double> z;
         for (const Eigen::Vector3d& p : o.mapped_points) z.push_back((frame.cam_from_world * p).z());
         const double depth = Median(z);
         if (depth > 0.0) {
-          const Eigen::Vector3d point = frame.cam_from_world.Inverse() * Eigen::Vector3d(Eigen::Vector3d(ref.x(), ref.y(), 1.0) * depth);
-          st = s.filter.InitializeFromPoint(b, point);
-          if (st.ok()) ++stats_.filters_from_static;
-        } else {
-          st = s.filter.Initialize(b);
+          job.start_point = frame.cam_from_world.Inverse() * Eigen::Vector3d(Eigen::Vector3d(ref.x(), ref.y(), 1.0) * depth);
         }
-      } else {
-        st = s.filter.Initialize(b);
       }
-      if (st.ok()) {
-        ++stats_.filters_started;
-        MBSLAM_LOG(INFO) << "object " << id << ": filter started, " << s.metres_per_unit << " m per map unit, "
-                         << (frame.ground ? "ground plane" : "no ground plane") << ", depth bound "
-                         << (b.depth_bound ? std::to_string(b.depth_bound->max) : std::string("none"))
-                         << (from_static ? ", previously static" : "");
-      }
-    } else {
-      st = s.filter.Update(b);
     }
-    if (!st.ok()) {
+    jobs.push_back(std::move(job));
+  }
+
+  // The filters of different objects share nothing (each has its own random numbers):
+  // they run on options_.threads threads with the same result as one.
+  ParallelFor(jobs.size(), options_.threads, [&](size_t k) {
+    FilterJob& j = jobs[k];
+    State& s = *j.state;
+    j.was_initialized = s.filter.initialized();
+    if (!j.was_initialized) {
+      j.status = j.start_point ? s.filter.InitializeFromPoint(j.observation, *j.start_point)
+                               : s.filter.Initialize(j.observation);
+    } else {
+      j.status = s.filter.Update(j.observation);
+    }
+    if (!j.status.ok()) return;
+    const BotEstimate e = s.filter.Estimate();
+    if (e.valid) s.extent.Update(frame.cam_from_world, j.track_xy, j.ref, e.depth, up_or_camera);
+  });
+
+  for (const FilterJob& j : jobs) {
+    State& s = *j.state;
+    if (!j.was_initialized && j.status.ok()) {
+      if (j.start_point) ++stats_.filters_from_static;
+      ++stats_.filters_started;
+      MBSLAM_LOG(INFO) << "object " << j.id << ": filter started, " << s.metres_per_unit << " m per map unit, "
+                       << (frame.ground ? "ground plane" : "no ground plane") << ", depth bound "
+                       << (j.observation.depth_bound ? std::to_string(j.observation.depth_bound->max) : std::string("none"))
+                       << (j.from_static ? ", previously static" : "");
+    }
+    if (!j.status.ok()) {
       ++stats_.rejected_updates;
-      MBSLAM_LOG(DEBUG) << "object " << id << " (segment " << o.id << "): " << st.message();
+      MBSLAM_LOG(DEBUG) << "object " << j.id << " (segment " << j.segment_id << "): " << j.status.message();
       continue;
     }
     s.last_seen_utime = frame.utime;
-    const BotEstimate e = s.filter.Estimate();
-    if (e.valid) s.extent.Update(frame.cam_from_world, o.track_xy, ref, e.depth, up_or_camera);
-    seen[id] = true;
+    seen[j.id] = true;
   }
 
+  std::vector<std::pair<int, State*>> report;  // in id order
   for (auto it = objects_.begin(); it != objects_.end();) {
     State& s = it->second;
     const bool now = seen.count(it->first) > 0;
-    if (!now) {
-      if (!s.filter.initialized() || frame.utime - s.last_seen_utime > options_.keep_unseen_us) {
-        ++stats_.filters_dropped;
-        for (auto m = object_of_segment_.begin(); m != object_of_segment_.end();) {
-          m = m->second.id == it->first ? object_of_segment_.erase(m) : std::next(m);
-        }
-        it = objects_.erase(it);
-        continue;
+    if (!now && (!s.filter.initialized() || frame.utime - s.last_seen_utime > options_.keep_unseen_us)) {
+      ++stats_.filters_dropped;
+      for (auto m = object_of_segment_.begin(); m != object_of_segment_.end();) {
+        m = m->second.id == it->first ? object_of_segment_.erase(m) : std::next(m);
       }
-      if (s.filter.utime() < frame.utime) (void)s.filter.Predict(frame.utime, frame.ground);
+      it = objects_.erase(it);
+      continue;
     }
-    TrackedObject t;
-    t.id = it->first;
+    report.emplace_back(it->first, &s);
+    ++it;
+  }
+  std::vector<TrackedObject> tracked(report.size());
+  ParallelFor(report.size(), options_.threads, [&](size_t k) {
+    const int id = report[k].first;
+    State& s = *report[k].second;
+    const bool now = seen.count(id) > 0;
+    if (!now && s.filter.utime() < frame.utime) (void)s.filter.Predict(frame.utime, frame.ground);
+    TrackedObject& t = tracked[k];
+    t.id = id;
     t.seen = now;
     t.segment_id = now ? s.segment_id : 0;
     t.last_seen_utime = s.last_seen_utime;
@@ -431,8 +472,9 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
       for (PredictedVolume& v : t.volumes) v.center += t.extent.center_offset;
     }
     t.metres_per_unit = s.metres_per_unit;
+  });
+  for (TrackedObject& t : tracked) {
     if (t.estimate.valid) out_.push_back(std::move(t));
-    ++it;
   }
   return out_;
 }

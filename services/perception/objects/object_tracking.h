@@ -71,6 +71,7 @@ struct ObjectTrackingOptions {
   // (m / unit). The SLAM sets the first map's median depth to 1 unit.
   double unit_guess_m = 5.0;
   int min_tracks = 3;                   // an object with fewer tracks in an image is not observed (count)
+  int threads = 2;                      // the objects' filters run on this many threads, same result (count)
   int64_t keep_unseen_us = 1000000;     // an unseen object is predicted and reported this long (µs)
   // What is kept of an object once it is gone (its id per segment id, first-seen time,
   // person class) is forgotten this long after it was last seen (µs); >= keep_unseen_us.
@@ -99,6 +100,7 @@ struct ObjectTrackingOptions {
     MBSLAM_CHECK_OPTION_GE(camera_height_m, 0.0);
     MBSLAM_CHECK_OPTION_GT(unit_guess_m, 0.0);
     MBSLAM_CHECK_OPTION_GE(min_tracks, 1);
+    MBSLAM_CHECK_OPTION(threads >= 1 && threads <= 16);
     MBSLAM_CHECK_OPTION_GE(keep_unseen_us, 0);
     MBSLAM_CHECK_OPTION_GE(forget_after_us, keep_unseen_us);
     MBSLAM_CHECK_OPTION_GE(depth_bound_margin, 0.0);
@@ -121,6 +123,7 @@ struct ObjectTrackingOptions {
     v("unit_guess_m", &unit_guess_m,
       "metres per map unit assumed without odometry or camera height (m/unit)");
     v("min_tracks", &min_tracks, "fewer tracks in an image: the object is not observed (count)");
+    v("threads", &threads, "the objects' filters run on this many threads, same result (count)");
     v("keep_unseen_us", &keep_unseen_us, "an unseen object is predicted and reported this long (us)");
     v("forget_after_us", &forget_after_us,
       "what is kept of a gone object (id per segment, first-seen time, class) is forgotten this long after "
