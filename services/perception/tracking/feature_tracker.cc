@@ -4,12 +4,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <future>
 
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "common/util/parallel_for.h"
 #include "services/perception/geometry/polygon.h"
 #include "services/perception/tracking/patch_matcher.h"
 
@@ -72,12 +72,7 @@ void TrackLk(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
     std::copy(q.begin(), q.end(), next->begin() + begin);
     std::copy(st.begin(), st.end(), status->begin() + begin);
   };
-  std::vector<std::future<void>> jobs;
-  for (size_t c = 1; c < chunks; ++c) {
-    jobs.push_back(std::async(std::launch::async, run, n * c / chunks, n * (c + 1) / chunks));
-  }
-  run(0, n / chunks);
-  for (auto& j : jobs) j.get();
+  ParallelFor(chunks, static_cast<int>(chunks), [&](size_t c) { run(n * c / chunks, n * (c + 1) / chunks); });
 }
 
 }  // namespace
