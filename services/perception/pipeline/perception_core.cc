@@ -249,7 +249,9 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
   const Eigen::Vector3d center = kf->cam_from_world.Inverse().translation;
   // Interpolated rays (dense_rays.h): inside the image triangulation of every static
   // point the keyframe sees, sampled at the map's voxel size (so only once it is fixed:
-  // the keyframe that fixes it gets them in a second scan).
+  // the keyframe that fixes it gets them in a second scan). Each point's depth
+  // uncertainty comes from the widest parallax among the keyframes observing it.
+  const DenseRayOptions& dense = options_.occupancy.dense;
   auto interpolated = [&]() {
     DenseRayInput in;
     in.cam_from_world = kf->cam_from_world;
@@ -258,13 +260,11 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
     in.moving_hulls_xy = moving_hulls_xy;
     in.points_in_world.reserve(kf->point_ids.size());
     in.depth_sigma.reserve(kf->point_ids.size());
-    const DenseRayOptions& dense_options = options_.occupancy.dense;
-    const double bearing_sigma = dense_options.bearing_sigma_px / focal_px;
+    const double bearing_sigma = dense.bearing_sigma_px / focal_px;
     std::vector<Eigen::Vector3d> centers;
     for (int64_t id : kf->point_ids) {
       const MapPoint* p = slam_.map().point(id);
       if (p == nullptr) continue;
-      // Its depth uncertainty from the keyframes that observe it.
       centers.clear();
       for (const Observation& o : p->observations) {
         if (o.keyframe_id == kf->id) continue;
@@ -276,20 +276,20 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
       in.depth_sigma.push_back(TriangulationDepthSigma(p->position, center, centers, bearing_sigma));
     }
     DenseRayStats stats;
-    std::vector<Eigen::Vector3d> samples = DensifyKeyframe(in, options_.occupancy.dense, &stats);
-    MBSLAM_LOG(DEBUG) << "occupancy: keyframe " << kf->id << " " << stats.points << " points, "
-                      << stats.uncertain << " too uncertain, " << stats.triangles << " triangles, " << stats.triangles_used << " used (edge "
-                      << stats.rejected_edge << ", depth " << stats.rejected_depth << ", incidence "
-                      << stats.rejected_incidence << ", moving " << stats.rejected_moving << " rejected), "
-                      << stats.samples << " samples, spacing x" << stats.spacing_scale;
+    std::vector<Eigen::Vector3d> samples = DensifyKeyframe(in, dense, &stats);
+    MBSLAM_LOG(DEBUG) << "occupancy: keyframe " << kf->id << " " << stats.points << " points ("
+                      << stats.uncertain << " too uncertain), " << stats.triangles << " triangles, "
+                      << stats.triangles_used << " used (rejected: edge " << stats.rejected_edge << ", depth "
+                      << stats.rejected_depth << ", incidence " << stats.rejected_incidence << ", moving "
+                      << stats.rejected_moving << "), " << stats.samples << " samples, spacing x"
+                      << stats.spacing_scale;
     return samples;
   };
-  const bool dense = options_.occupancy.dense.enabled;
-  if (dense && occupancy_->IsResolutionFixed()) {
+  if (dense.enabled && occupancy_->IsResolutionFixed()) {
     occupancy_->InsertRays(center, points, interpolated());
   } else {
     occupancy_->InsertRays(center, points);
-    if (dense && occupancy_->IsResolutionFixed()) occupancy_->InsertRays(center, {}, interpolated());
+    if (dense.enabled && occupancy_->IsResolutionFixed()) occupancy_->InsertRays(center, {}, interpolated());
   }
   if (occupancy_->crops() > crops_before) {
     counters_->Increment(counter::kOccupancyCrops, occupancy_->crops() - crops_before);
