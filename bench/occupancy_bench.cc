@@ -2,6 +2,7 @@
 // 100-300 new points with ranges up to ~20 m, one core).
 //
 //   build/bin/occupancy_bench [--benchmark_filter=InsertRays]
+//   build/bin/occupancy_bench --benchmark_filter=Dense   # with interpolated rays
 //
 // The scene: a camera walking along a street (x forward, 0.5 m between keyframes) sees
 // new static points on the facades left and right and on the ground, 1 to 20 m away,
@@ -20,6 +21,8 @@
 
 #include <octomap/OcTree.h>
 
+#include "services/perception/geometry/rigid3.h"
+#include "services/perception/occupancy/dense_rays.h"
 #include "services/perception/occupancy/occupancy_map.h"
 #include "services/perception/occupancy/octree_ops.h"
 
@@ -123,6 +126,89 @@ void BM_Serialize(benchmark::State& state) {
   state.counters["occupied_voxels"] = static_cast<double>(map.NumOccupied());
 }
 BENCHMARK(BM_Serialize)->Arg(10)->Arg(5)->Unit(benchmark::kMillisecond);
+
+// The same street seen by a 640 x 480 camera (f = 525 px) looking along x: the static
+// points in its view (all of them are triangulated for interpolated rays), the first
+// `num_new` of them new at this keyframe (measured rays).
+struct DenseKeyframe {
+  mbslam::Rigid3d cam_from_world;
+  Eigen::Vector3d camera;
+  std::vector<Eigen::Vector3d> seen;
+  std::vector<Eigen::Vector3d> fresh;
+};
+
+DenseKeyframe MakeDenseKeyframe(int k, int num_seen, int num_new, std::mt19937* rng) {
+  DenseKeyframe kf;
+  kf.camera = Eigen::Vector3d(0.5 * k, 0.0, 1.6);
+  // cam z = world x, cam x = -world y, cam y = -world z.
+  Eigen::Matrix3d r;
+  r << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  kf.cam_from_world = mbslam::Rigid3d(Eigen::Quaterniond(r), -(r * kf.camera));
+  while (static_cast<int>(kf.seen.size()) < num_seen) {
+    for (const Eigen::Vector3d& p : MakeKeyframe(k, 64, 20.0, rng).points) {
+      const Eigen::Vector3d c = kf.cam_from_world * p;
+      if (c.z() > 0.5 && std::abs(525.0 * c.x() / c.z()) < 320.0 && std::abs(525.0 * c.y() / c.z()) < 240.0 &&
+          static_cast<int>(kf.seen.size()) < num_seen) {
+        kf.seen.push_back(p);
+      }
+    }
+  }
+  kf.fresh.assign(kf.seen.begin(), kf.seen.begin() + std::min(num_new, num_seen));
+  return kf;
+}
+
+// Per keyframe with interpolated rays: triangulation, sampling and the tree update.
+// Args: static points seen, voxel edge (cm), new points among them (measured rays; 0
+// times the interpolated part alone).
+void BM_DenseKeyframe(benchmark::State& state) {
+  const int num_seen = static_cast<int>(state.range(0));
+  const double resolution = 0.01 * static_cast<double>(state.range(1));
+  const int num_new = static_cast<int>(state.range(2));
+  OccupancyMap map(Options(resolution), OccupancyMap::Units::kMetres);
+  const mbslam::DenseRayOptions& dense = map.options().dense;
+  std::mt19937 rng(17);
+  auto insert = [&](const DenseKeyframe& kf, mbslam::DenseRayStats* stats) {
+    mbslam::DenseRayInput in;
+    in.cam_from_world = kf.cam_from_world;
+    in.points_in_world = kf.seen;
+    in.focal_px = 525.0;
+    in.voxel = map.resolution();
+    return map.InsertRays(kf.camera, kf.fresh, mbslam::DensifyKeyframe(in, dense, stats));
+  };
+  int k = 0;
+  mbslam::DenseRayStats stats;
+  for (; k < 60; ++k) {
+    insert(MakeDenseKeyframe(k, num_seen, 150, &rng), &stats);  // warm-up with measured rays
+  }
+  std::vector<DenseKeyframe> pending;
+  double samples = 0.0, rays = 0.0, iterations = 0.0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    if (pending.empty()) {
+      for (int i = 0; i < 32; ++i) {
+        pending.push_back(MakeDenseKeyframe(k++, num_seen, num_new, &rng));
+      }
+      std::reverse(pending.begin(), pending.end());
+    }
+    const DenseKeyframe kf = std::move(pending.back());
+    pending.pop_back();
+    state.ResumeTiming();
+    const mbslam::OccupancyInsertSummary s = insert(kf, &stats);
+    benchmark::DoNotOptimize(s.rays_inserted);
+    samples += stats.samples;
+    rays += s.interpolated_inserted;
+    iterations += 1.0;
+  }
+  state.counters["points"] = num_seen;
+  state.counters["new_points"] = num_new;
+  state.counters["resolution_m"] = resolution;
+  state.counters["samples"] = samples / std::max(1.0, iterations);
+  state.counters["interp_rays"] = rays / std::max(1.0, iterations);
+  state.counters["occupied_voxels"] = static_cast<double>(map.NumOccupied());
+}
+BENCHMARK(BM_DenseKeyframe)
+    ->ArgsProduct({{200, 400, 800}, {10, 5}, {0, 150}})
+    ->Unit(benchmark::kMillisecond);
 
 // The one-off rebuild when the map switches to metres: 200 keyframes x 300 rays.
 void BM_RescaleRebuild(benchmark::State& state) {

@@ -35,6 +35,7 @@ OccupancyMap::OccupancyMap(const OccupancyMapOptions& options, Units units)
     MBSLAM_LOG(WARNING) << "occupancy: " << LastOptionError() << "; using the defaults";
     options_ = OccupancyMapOptions();
   }
+  weak_hit_log_odds_ = static_cast<float>(std::log(options_.dense.prob_hit / (1.0 - options_.dense.prob_hit)));
   if (units_ == Units::kMetres || options_.resolution_depth_fraction <= 0.0) {
     double resolution = 0.0, max_range = 0.0;
     MetricResolution(&resolution, &max_range);
@@ -53,10 +54,12 @@ double OccupancyMap::resolution() const { return tree_ ? tree_->getResolution() 
 
 OccupancyInsertSummary OccupancyMap::InsertRays(
     const Eigen::Vector3d& camera_center_in_world,
-    const std::vector<Eigen::Vector3d>& points_in_world) {
+    const std::vector<Eigen::Vector3d>& points_in_world,
+    const std::vector<Eigen::Vector3d>& interpolated_in_world) {
   OccupancyInsertSummary summary;
   if (!camera_center_in_world.allFinite()) {
     summary.rays_rejected = static_cast<int>(points_in_world.size());
+    summary.interpolated_rejected = static_cast<int>(interpolated_in_world.size());
     return summary;
   }
   RayBatch batch;
@@ -69,7 +72,15 @@ OccupancyInsertSummary OccupancyMap::InsertRays(
     }
     batch.ends.push_back(p.cast<float>());
   }
-  if (batch.ends.empty()) {
+  batch.interpolated.reserve(interpolated_in_world.size());
+  for (const Eigen::Vector3d& p : interpolated_in_world) {
+    if (!p.allFinite() || (p - camera_center_in_world).norm() < kMinRayLength) {
+      ++summary.interpolated_rejected;
+      continue;
+    }
+    batch.interpolated.push_back(p.cast<float>());
+  }
+  if (batch.ends.empty() && batch.interpolated.empty()) {
     return summary;
   }
 
@@ -77,9 +88,10 @@ OccupancyInsertSummary OccupancyMap::InsertRays(
     // Up to scale, resolution not fixed yet: collect rays until their median length
     // is known, then build the tree from all of them.
     summary.rays_buffered = static_cast<int>(batch.ends.size());
+    stored_rays_ += static_cast<int64_t>(batch.size());
+    buffered_measured_rays_ += summary.rays_buffered;
     batches_.push_back(std::move(batch));
-    stored_rays_ += summary.rays_buffered;
-    if (stored_rays_ >= options_.min_rays_for_resolution) {
+    if (buffered_measured_rays_ >= options_.min_rays_for_resolution) {
       const double median = MedianStoredRayLength();
       const double resolution = options_.resolution_depth_fraction * median;
       const double max_range = options_.max_range_depth_multiple > 0.0
@@ -89,7 +101,7 @@ OccupancyInsertSummary OccupancyMap::InsertRays(
         MBSLAM_LOG(INFO) << "occupancy: median ray length " << median << " map units: voxel edge "
                          << resolution << ", range bound " << max_range;
         Rebuild(resolution, max_range);
-        summary.rays_inserted = static_cast<int>(stored_rays_);
+        summary.rays_inserted = static_cast<int>(buffered_measured_rays_);
         StoreBatch(RayBatch());  // applies the bound on stored rays
         ++revision_;
       }
@@ -184,16 +196,46 @@ void OccupancyMap::InsertBatch(const RayBatch& batch, OccupancyInsertSummary* su
     }
     ++summary->rays_inserted;
   }
-  num_occupied_ += ApplyVoxelUpdates(tree_.get(), &updates_);
+  // Interpolated end points: one ray per end voxel (to the first point in it), a weak
+  // hit there, free space on the way when asked; none beyond the range bound.
+  ends_by_voxel_.clear();
+  for (size_t i = 0; i < batch.interpolated.size(); ++i) {
+    const Eigen::Vector3f& e = batch.interpolated[i];
+    const octomap::point3d p(e.x(), e.y(), e.z());
+    octomap::OcTreeKey end_key;
+    if ((max_range_ >= 0.0 && (p - origin).norm() > max_range_) || !KeyInTree(*tree_, p, end_key)) {
+      ++summary->interpolated_rejected;
+      continue;
+    }
+    ends_by_voxel_.emplace_back(WeakHitVoxelUpdate(end_key), static_cast<uint32_t>(i));
+  }
+  std::sort(ends_by_voxel_.begin(), ends_by_voxel_.end());  // per voxel, the first point first
+  for (size_t n = 0; n < ends_by_voxel_.size(); ++n) {
+    if (n > 0 && ends_by_voxel_[n].first == ends_by_voxel_[n - 1].first) {
+      ++summary->interpolated_merged;
+      continue;
+    }
+    if (options_.dense.free_space) {
+      const Eigen::Vector3f& e = batch.interpolated[ends_by_voxel_[n].second];
+      if (tree_->computeRayKeys(origin, octomap::point3d(e.x(), e.y(), e.z()), *key_ray_)) {
+        for (const octomap::OcTreeKey& k : *key_ray_) {
+          updates_.push_back(VoxelUpdate(k, false));
+        }
+      }
+    }
+    updates_.push_back(ends_by_voxel_[n].first);
+    ++summary->interpolated_inserted;
+  }
+  num_occupied_ += ApplyVoxelUpdates(tree_.get(), &updates_, weak_hit_log_odds_);
 }
 
 void OccupancyMap::StoreBatch(RayBatch batch) {
-  stored_rays_ += static_cast<int64_t>(batch.ends.size());
-  if (!batch.ends.empty()) {
+  stored_rays_ += static_cast<int64_t>(batch.size());
+  if (batch.size() > 0) {
     batches_.push_back(std::move(batch));
   }
   while (!batches_.empty() && stored_rays_ > options_.max_stored_rays) {
-    const int64_t n = static_cast<int64_t>(batches_.front().ends.size());
+    const int64_t n = static_cast<int64_t>(batches_.front().size());
     stored_rays_ -= n;
     rays_forgotten_ += n;
     batches_.pop_front();
@@ -242,8 +284,8 @@ void OccupancyMap::BoundMemory(const Eigen::Vector3d& center) {
   const double reach = (half + 0.5) * res;
   for (auto it = batches_.begin(); it != batches_.end();) {
     if (((it->origin - center).cwiseAbs().array() > reach).any()) {
-      stored_rays_ -= static_cast<int64_t>(it->ends.size());
-      rays_forgotten_ += static_cast<int64_t>(it->ends.size());
+      stored_rays_ -= static_cast<int64_t>(it->size());
+      rays_forgotten_ += static_cast<int64_t>(it->size());
       it = batches_.erase(it);
     } else {
       ++it;
@@ -297,6 +339,9 @@ Status OccupancyMap::Rescale(double factor, Units units) {
   for (RayBatch& batch : batches_) {
     batch.origin *= factor;
     for (Eigen::Vector3f& end : batch.ends) {
+      end *= f;
+    }
+    for (Eigen::Vector3f& end : batch.interpolated) {
       end *= f;
     }
   }

@@ -7,8 +7,16 @@
 // (log-odds, Thrun et al. ch. 9, as OctoMap implements it). Moving objects are never
 // inserted: the caller passes static points only.
 //
+// Interpolated rays. Sparse points cover a surface a point here and there; the caller
+// may add interpolated end points (dense_rays.h: samples inside the image triangulation
+// of the keyframe's static points). They are reduced to one ray per end voxel, their
+// end voxel gets the weaker `dense.prob_hit`, and they give free space along their way
+// when `dense.free_space`. Within one InsertRays call every voxel is updated once: a
+// hit beats a weak hit beats a miss.
+//
 //   OccupancyMap map(OccupancyMapOptions(), OccupancyMap::Units::kUpToScale);
-//   map.InsertRays(world_from_cam.translation, new_points_in_world);   // per keyframe
+//   map.InsertRays(world_from_cam.translation, new_points_in_world,
+//                  interpolated_points_in_world);                        // per keyframe
 //   map.Rescale(metres_per_unit, OccupancyMap::Units::kMetres);        // once scale is known
 //   std::string binary;
 //   map.Serialize(&binary);   // occupancy_t.data; readers use ReadOctreeBinary (octree_io.h)
@@ -39,12 +47,14 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "common/config/options.h"
 #include "common/util/status.h"
+#include "services/perception/occupancy/dense_rays.h"
 
 namespace octomap {
 class OcTree;
@@ -91,6 +101,8 @@ struct OccupancyMapOptions {
   // Rays of one insert are first reduced to one per end voxel (faster, slightly
   // different result: OctoMap's discretised update) (bool).
   bool discretize = false;
+  // Interpolated rays inside the triangulated keyframe points (dense_rays.h).
+  DenseRayOptions dense;
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(resolution_m, 0.0);
@@ -112,6 +124,8 @@ struct OccupancyMapOptions {
     MBSLAM_CHECK_OPTION_GE(max_memory_mb, 0.0);
     MBSLAM_CHECK_OPTION_GE(keep_half_edge_voxels, 1);
     MBSLAM_CHECK_OPTION_LE(keep_half_edge_voxels, 32767);
+    MBSLAM_CHECK_OPTION_SECTION(dense);
+    MBSLAM_CHECK_OPTION_LE(dense.prob_hit, prob_hit);
     return true;
   }
 
@@ -146,6 +160,8 @@ struct OccupancyMapOptions {
       "is below half of max_memory_mb (voxels)");
     v("discretize", &discretize,
       "reduce the rays of one insert to one per end voxel first (faster, slightly different)");
+    v("dense", &dense,
+      "interpolated rays inside the image triangulation of each keyframe's static points");
   }
 };
 
@@ -155,6 +171,9 @@ struct OccupancyInsertSummary {
   int rays_buffered = 0;   // rays stored while the resolution is not fixed yet (count)
   int rays_rejected = 0;   // non-finite points or points at the camera centre (count)
   int rays_truncated = 0;  // rays longer than the range bound: free space only (count)
+  int interpolated_inserted = 0;  // interpolated rays integrated, one per end voxel (count)
+  int interpolated_merged = 0;    // interpolated end points sharing an end voxel with another (count)
+  int interpolated_rejected = 0;  // non-finite, at the camera centre or beyond the range bound (count)
 };
 
 class OccupancyMap {
@@ -167,10 +186,13 @@ class OccupancyMap {
   OccupancyMap(const OccupancyMap&) = delete;
   OccupancyMap& operator=(const OccupancyMap&) = delete;
 
-  // Integrates rays from the camera centre to each point (world frame, map units).
-  // Non-finite points and points at the camera centre are rejected and counted.
+  // Integrates rays from the camera centre to each point (world frame, map units), and
+  // to each interpolated point (weaker hit, one per end voxel, none beyond the range
+  // bound), as one scan. Non-finite points and points at the camera centre are rejected
+  // and counted.
   OccupancyInsertSummary InsertRays(const Eigen::Vector3d& camera_center_in_world,
-                                    const std::vector<Eigen::Vector3d>& points_in_world);
+                                    const std::vector<Eigen::Vector3d>& points_in_world,
+                                    const std::vector<Eigen::Vector3d>& interpolated_in_world = {});
 
   // The world's units changed: every position is multiplied by `factor` (> 0) and the
   // map is now in `units`. Rebuilds the tree from the stored rays. Staying up to scale
@@ -230,6 +252,8 @@ class OccupancyMap {
   struct RayBatch {
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // camera centre (map units)
     std::vector<Eigen::Vector3f> ends;                 // end points (map units)
+    std::vector<Eigen::Vector3f> interpolated;         // interpolated end points (map units)
+    size_t size() const { return ends.size() + interpolated.size(); }
   };
 
   // Sets the voxel edge and range bound (map units) and rebuilds from the stored rays.
@@ -252,6 +276,9 @@ class OccupancyMap {
   // Scratch buffers of InsertBatch (OctoMap's KeyRay allocates 100k keys).
   std::unique_ptr<octomap::KeyRay> key_ray_;
   std::vector<uint64_t> updates_;
+  std::vector<std::pair<uint64_t, uint32_t>> ends_by_voxel_;  // interpolated: (update, index)
+  float weak_hit_log_odds_ = 0.0f;  // log-odds of dense.prob_hit
+  int64_t buffered_measured_rays_ = 0;  // measured rays buffered before the resolution is fixed
   int64_t stored_rays_ = 0;
   int64_t rays_forgotten_ = 0;
   int64_t revision_ = 0;

@@ -121,7 +121,7 @@ octomap::OcTreeKey OctreeKeyOfMortonCode(uint64_t code) {
   return octomap::OcTreeKey(CompactBits(code), CompactBits(code >> 1), CompactBits(code >> 2));
 }
 
-int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates) {
+int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates, float weak_hit_log_odds) {
   std::vector<uint64_t>& u = *updates;
   if (u.empty()) {
     return 0;
@@ -138,13 +138,17 @@ int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates)
   };
 
   size_t i = 0;
-  // The next voxel and whether any of its entries is a hit (sorted: hits come last).
+  // The next voxel, whether any of its entries is a (weak) hit and the log-odds change
+  // (sorted: the strongest kind comes last).
+  float change = miss;
   auto next = [&](uint64_t* code, bool* is_hit) {
-    *code = u[i] >> 1;
-    while (i + 1 < u.size() && (u[i + 1] >> 1) == *code) {
+    *code = u[i] >> 2;
+    while (i + 1 < u.size() && (u[i + 1] >> 2) == *code) {
       ++i;
     }
-    *is_hit = (u[i] & 1u) != 0;
+    const unsigned kind = static_cast<unsigned>(u[i] & 3u);
+    *is_hit = kind != 0;
+    change = kind == 2 ? hit : (kind == 1 ? weak_hit_log_odds : miss);
     ++i;
   };
 
@@ -155,7 +159,7 @@ int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates)
     // The first voxel of an empty tree goes through OctoMap, which creates the root.
     next(&code, &is_hit);
     const octomap::OcTreeKey key = OctreeKeyOfMortonCode(code);
-    tree->updateNode(key, is_hit ? hit : miss, /*lazy_eval=*/false);
+    tree->updateNode(key, change, /*lazy_eval=*/false);
     const octomap::OcTreeNode* leaf = tree->search(key);
     if (leaf != nullptr && tree->isNodeOccupied(leaf)) {
       ++delta;
@@ -225,7 +229,7 @@ int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates)
     octomap::OcTreeNode* leaf = path[kTreeDepth];
     const bool was_occupied = !created[kTreeDepth] && leaf->getLogOdds() >= occupied;
     if (!saturated(leaf, is_hit)) {
-      tree->updateNodeLogOdds(leaf, is_hit ? hit : miss);
+      tree->updateNodeLogOdds(leaf, change);
     }
     const bool is_occupied = leaf->getLogOdds() >= occupied;
     delta += static_cast<int>(is_occupied) - static_cast<int>(was_occupied);

@@ -29,17 +29,23 @@ namespace mbslam {
 uint64_t OctreeMortonCode(const octomap::OcTreeKey& key);
 octomap::OcTreeKey OctreeKeyOfMortonCode(uint64_t code);
 
-// One voxel update for ApplyVoxelUpdates: OctreeMortonCode(key) << 1 | (1 if hit).
+// One voxel update for ApplyVoxelUpdates: OctreeMortonCode(key) << 2 | kind, kind 0 a
+// miss, 1 a weak hit (an interpolated end point), 2 a hit.
 inline uint64_t VoxelUpdate(const octomap::OcTreeKey& key, bool hit) {
-  return OctreeMortonCode(key) << 1 | (hit ? 1u : 0u);
+  return OctreeMortonCode(key) << 2 | (hit ? 2u : 0u);
+}
+inline uint64_t WeakHitVoxelUpdate(const octomap::OcTreeKey& key) {
+  return OctreeMortonCode(key) << 2 | 1u;
 }
 
 // Applies one scan's voxel updates at the finest depth: every voxel listed is updated
-// once, with the hit log-odds if any of its entries is a hit, else with the miss
-// log-odds (OctoMap's insertPointCloud semantics, non-lazy: inner nodes are updated and
-// pruned). Sorts `updates` in place. Returns the change in the number of occupied
-// voxels at the finest resolution.
-int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates);
+// once, with the hit log-odds if any of its entries is a hit, else with
+// `weak_hit_log_odds` if any is a weak hit, else with the miss log-odds (OctoMap's
+// insertPointCloud semantics, non-lazy: inner nodes are updated and pruned). Without
+// weak hits this is exactly the update step of insertPointCloud. Sorts `updates` in
+// place. Returns the change in the number of occupied voxels at the finest resolution.
+int64_t ApplyVoxelUpdates(octomap::OcTree* tree, std::vector<uint64_t>* updates,
+                          float weak_hit_log_odds = 0.0f);
 
 // A new tree with the parameters of `tree` (resolution, hit / miss log-odds, clamping,
 // occupancy threshold) holding the nodes of `tree` that overlap the box of finest-level

@@ -224,7 +224,9 @@ DepthBound PerceptionCore::DepthBoundFor(int64_t track_id, const Eigen::Vector2d
   return bound;
 }
 
-void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime, FrameResult* result) {
+void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime, double focal_px,
+                                     const std::vector<std::vector<Eigen::Vector2d>>& moving_hulls_xy,
+                                     FrameResult* result) {
   if (!options_.occupancy_enabled) return;
   ScopedStageTimer timer(occupancy_timer_);
   const OccupancyMap::Units units = slam_.metric() ? OccupancyMap::Units::kMetres : OccupancyMap::Units::kUpToScale;
@@ -248,7 +250,51 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
   }
   const int64_t crops_before = occupancy_->crops();
   const int64_t dropped_before = occupancy_->occupied_voxels_dropped();
-  occupancy_->InsertRays(kf->cam_from_world.Inverse().translation, points);
+  const Eigen::Vector3d center = kf->cam_from_world.Inverse().translation;
+  // Interpolated rays (dense_rays.h): inside the image triangulation of every static
+  // point the keyframe sees, sampled at the map's voxel size (so only once it is fixed:
+  // the keyframe that fixes it gets them in a second scan). Each point's depth
+  // uncertainty comes from the widest parallax among the keyframes observing it.
+  const DenseRayOptions& dense = options_.occupancy.dense;
+  auto interpolated = [&]() {
+    DenseRayInput in;
+    in.cam_from_world = kf->cam_from_world;
+    in.focal_px = focal_px;
+    in.voxel = occupancy_->resolution();
+    in.moving_hulls_xy = moving_hulls_xy;
+    in.points_in_world.reserve(kf->point_ids.size());
+    in.depth_sigma.reserve(kf->point_ids.size());
+    const double bearing_sigma = dense.bearing_sigma_px / focal_px;
+    std::vector<Eigen::Vector3d> centers;
+    for (int64_t id : kf->point_ids) {
+      const MapPoint* p = slam_.map().point(id);
+      if (p == nullptr) continue;
+      centers.clear();
+      for (const Observation& o : p->observations) {
+        if (o.keyframe_id == kf->id) continue;
+        if (const Keyframe* other = slam_.map().keyframe(o.keyframe_id)) {
+          centers.push_back(other->cam_from_world.Inverse().translation);
+        }
+      }
+      in.points_in_world.push_back(p->position);
+      in.depth_sigma.push_back(TriangulationDepthSigma(p->position, center, centers, bearing_sigma));
+    }
+    DenseRayStats stats;
+    std::vector<Eigen::Vector3d> samples = DensifyKeyframe(in, dense, &stats);
+    MBSLAM_LOG(DEBUG) << "occupancy: keyframe " << kf->id << " " << stats.points << " points ("
+                      << stats.uncertain << " too uncertain), " << stats.triangles << " triangles, "
+                      << stats.triangles_used << " used (rejected: edge " << stats.rejected_edge << ", depth "
+                      << stats.rejected_depth << ", incidence " << stats.rejected_incidence << ", moving "
+                      << stats.rejected_moving << "), " << stats.samples << " samples, spacing x"
+                      << stats.spacing_scale;
+    return samples;
+  };
+  if (dense.enabled && occupancy_->IsResolutionFixed()) {
+    occupancy_->InsertRays(center, points, interpolated());
+  } else {
+    occupancy_->InsertRays(center, points);
+    if (dense.enabled && occupancy_->IsResolutionFixed()) occupancy_->InsertRays(center, {}, interpolated());
+  }
   if (occupancy_->crops() > crops_before) {
     counters_->Increment(counter::kOccupancyCrops, occupancy_->crops() - crops_before);
     counters_->Increment(counter::kOccupancyVoxelsDropped, occupancy_->occupied_voxels_dropped() - dropped_before);
@@ -493,7 +539,23 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   }
   if (map_update.culled_points > 0) counters_->Increment(counter::kMapPointsCulled, map_update.culled_points);
   if (map_update.new_keyframe) UpdateGroundPlane();
-  UpdateOccupancy(map_update, frame.utime, &result);
+  {
+    // This image's moving objects, and those predicted for it: no static evidence there.
+    std::vector<std::vector<Eigen::Vector2d>> moving_hulls_xy;
+    if (options_.occupancy_enabled && map_update.new_keyframe) {
+      for (const SegmentedObject& o : seg.objects) {
+        std::vector<Eigen::Vector2d> xy;
+        for (const Eigen::Vector2d& p : o.hull) xy.push_back(intrinsics.PixelToNormalized(p));
+        if (xy.size() >= 3) moving_hulls_xy.push_back(std::move(xy));
+      }
+      for (const std::vector<Eigen::Vector2f>& h : slam_frame.moving_hulls_xy) {
+        std::vector<Eigen::Vector2d> xy;
+        for (const Eigen::Vector2f& p : h) xy.push_back(p.cast<double>());
+        if (xy.size() >= 3) moving_hulls_xy.push_back(std::move(xy));
+      }
+    }
+    UpdateOccupancy(map_update, frame.utime, 0.5 * (intrinsics.fx + intrinsics.fy), moving_hulls_xy, &result);
+  }
   if (map_update.rescaled_by && ground_) ground_->Rescale(*map_update.rescaled_by);
   FillCameraPose(slam_pose, &result.camera_pose);
   for (const auto& [f, cam_from_world] : slam_pose.backfilled) {

@@ -135,8 +135,12 @@ class PerceptionCore : public FrameProcessor {
   std::optional<Rigid3d> OdometryCameraPose(int64_t utime) const;
   void FillCameraPose(const SlamPose& pose, CameraPoseOutput* out) const;
   void UpdateGroundPlane();
-  // Rays from the new keyframe to its new static points; the tree re-published when it changed.
-  void UpdateOccupancy(const SlamMapUpdate& update, int64_t utime, FrameResult* result);
+  // Rays from the new keyframe to its new static points, and interpolated rays inside the
+  // image triangulation of all static points it sees (not across `moving_hulls_xy`, the
+  // moving objects' outlines in normalised coordinates); the tree re-published when it
+  // changed.
+  void UpdateOccupancy(const SlamMapUpdate& update, int64_t utime, double focal_px,
+                       const std::vector<std::vector<Eigen::Vector2d>>& moving_hulls_xy, FrameResult* result);
   // SLAM's depth bound of a track, capped by where its ray meets the ground.
   DepthBound DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const;
   MapOutput BuildMapOutput(int64_t utime) const;
