@@ -168,11 +168,28 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
       }
     }
     back_pts = prev_pts;
+    back_status.assign(prev_pts.size(), 0);
     // The backward pass starts where the track came from; with fewer levels it is faster
     // but lets more false matches through (7.5 % of tracks on an unrelated image with 3
-    // levels, 10 % with 2, 11.6 % with 1: feature_tracker_test).
-    TrackLk(pyramid, prev_pyramid_, next_pts, &back_pts, &back_status, win, options_.klt_backward_levels - 1,
-            term, options_.klt_threads);
+    // levels, 10 % with 2, 11.6 % with 1: feature_tracker_test). Only the points the
+    // forward pass found go back (each point is tracked on its own: the same result).
+    std::vector<size_t> found;
+    std::vector<cv::Point2f> found_next, found_back;
+    for (size_t k = 0; k < prev_pts.size(); ++k) {
+      if (!status[k]) continue;
+      found.push_back(k);
+      found_next.push_back(next_pts[k]);
+      found_back.push_back(prev_pts[k]);
+    }
+    if (!found.empty()) {
+      std::vector<uint8_t> found_status;
+      TrackLk(pyramid, prev_pyramid_, found_next, &found_back, &found_status, win, options_.klt_backward_levels - 1,
+              term, options_.klt_threads);
+      for (size_t f = 0; f < found.size(); ++f) {
+        back_pts[found[f]] = found_back[f];
+        back_status[found[f]] = found_status[f];
+      }
+    }
   }
 
   const float fb2 = static_cast<float>(options_.max_forward_backward_px *
