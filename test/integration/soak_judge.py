@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""Verdict of a soak run (test/integration/soak.sh) from the monitor's CSV.
+
+  soak_judge.py RSS_CSV MINUTES MAX_SLOPE SERVICE_ALIVE SERVICE_EXIT ASAN LEAKS SCENARIO
+
+Re-scores a finished run without running it again (e.g. out/eval/soak*/run*/rss.csv
+with MINUTES 20 MAX_SLOPE 0.5 1 0 0 null crossing). Prints a summary and, last, the
+JSON; exits 0 when the run passed.
+"""
+import csv, json, sys
+path, minutes, max_slope = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
+alive, exit_code, asan, leaks, scenario = int(sys.argv[4]), int(sys.argv[5]), int(sys.argv[6]), sys.argv[7], sys.argv[8]
+leaks = None if leaks == "null" else int(leaks)
+rows = [r for r in csv.DictReader(open(path))]
+MB = 1024.0 * 1024.0
+# The map's own memory, per element as measured (mallinfo2) on the real Map class
+# (services/perception/slam/map.h): a point with its 11x11 patch ~610 B plus ~42 B per
+# observation, a keyframe with ~300 static tracks ~46 KB; rounded up. The OcTree: the
+# service's estimate of its own tree (occupancy_t.memory_bytes).
+POINT_B, OBSERVATION_B, KEYFRAME_B = 650.0, 48.0, 48.0 * 1024
+def map_mb(r):
+    return (float(r["map_points"]) * POINT_B + float(r["map_observations"]) * OBSERVATION_B +
+            float(r["map_keyframes"]) * KEYFRAME_B + float(r["occupancy_mem_bytes"])) / MB
+# What the service keeps for its trajectory files (ResultRecorder: 64 B a pose, vectors
+# growing by doubling: 96 B on average), bounded by ResultRecorder::kDefaultMaxPoses.
+POSE_B = 96.0
+def trajectory_mb(r):
+    return float(r["trajectory_poses"]) * POSE_B / MB
+t = [float(r["t_s"]) / 60.0 for r in rows]
+rss = [float(r["rss_mb"]) for r in rows]
+
+def fit(xs, ys):
+    n = len(xs)
+    if n < 3:
+        return None
+    mx, my = sum(xs) / n, sum(ys) / n
+    sxx = sum((x - mx) ** 2 for x in xs)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx if sxx > 0 else None
+
+# After a warm-up (10 % of the run, at least 1 min): the retained memory is the minimum
+# of each minute (transient peaks -- bundle adjustment, message buffers -- excluded).
+warm = max(1.0, 0.1 * minutes)
+bins = {}
+for i, r in enumerate(rows):
+    if t[i] < warm:
+        continue
+    b = int(t[i])
+    if b not in bins or rss[i] < rss[bins[b]]:
+        bins[b] = i
+mins = [bins[b] for b in sorted(bins)]
+slope_raw = fit([t[i] for i in range(len(rows)) if t[i] >= warm], [rss[i] for i in range(len(rows)) if t[i] >= warm])
+slope_min = fit([t[i] for i in mins], [rss[i] for i in mins])
+slope_map = fit([t[i] for i in mins], [map_mb(rows[i]) for i in mins])
+slope_traj = fit([t[i] for i in mins], [trajectory_mb(rows[i]) for i in mins])
+# The allocator keeps what the map frees (culled points, a cropped OcTree) for its later
+# growth instead of returning it to the system, so after the map shrinks the RSS stays at
+# the map's largest size: what the map accounts for is its high-water mark so far.
+map_high = []
+for r in rows:
+    map_high.append(max(map_high[-1] if map_high else 0.0, map_mb(r)))
+slope_beyond = fit([t[i] for i in mins], [rss[i] - map_high[i] - trajectory_mb(rows[i]) for i in mins])
+# Against the current map size instead (reported, not judged: steps up at every crop).
+slope_beyond_current = fit([t[i] for i in mins], [rss[i] - map_mb(rows[i]) - trajectory_mb(rows[i]) for i in mins])
+half = [i for i in range(len(rows)) if t[i] >= t[-1] / 2] if rows else []
+first_half = [i for i in range(len(rows)) if warm <= t[i] < t[-1] / 2] if rows else []
+def half_max(col, idx):
+    return max((float(rows[i][col]) for i in idx), default=0.0)
+# Bounded: the second half does not exceed the first half's largest value by more than
+# 10 % (a map oscillating under keyframe culling, or an OcTree regrowing to its memory
+# bound after a crop, is bounded; one that keeps growing is not).
+def bounded(col):
+    return half_max(col, half) <= 1.1 * max(1.0, half_max(col, first_half))
+def growth(col):  # per minute over the second half
+    return fit([t[i] for i in half], [float(rows[i][col]) for i in half])
+frames = int(rows[-1]["frames_processed"]) if rows else 0
+received = int(rows[-1]["frames_received"]) if rows else 0
+dropped = int(rows[-1]["frames_dropped"]) if rows else 0
+duration = t[-1] if t else 0.0
+r2 = lambda v: None if v is None else round(v, 4)
+# Under AddressSanitizer the RSS is no measure of retained memory: freed blocks stay in
+# its quarantine (256 MB by default) and every allocation has shadow and redzones, so
+# a 5-minute run grows by hundreds of MB without a leak. There the verdict is
+# LeakSanitizer's; the slopes are printed but not judged.
+slope_ok = asan == 1 or (slope_beyond is not None and slope_beyond <= max_slope)
+ok = (alive == 1 and exit_code == 0 and duration >= 0.95 * minutes and frames > 0 and
+      slope_ok and (leaks in (None, 0)))
+out = {
+    "scenario": scenario, "duration_min": round(duration, 2), "samples": len(rows),
+    "rss_start_mb": rss[0] if rss else None, "rss_end_mb": rss[-1] if rss else None,
+    "rss_max_mb": max(rss) if rss else None,
+    "rss_slope_mb_per_min": r2(slope_raw),
+    "rss_retained_slope_mb_per_min": r2(slope_min),
+    "map_mem_slope_mb_per_min": r2(slope_map),
+    "trajectory_mem_slope_mb_per_min": r2(slope_traj),
+    "rss_slope_beyond_map_mb_per_min": r2(slope_beyond),
+    "rss_slope_beyond_current_map_mb_per_min": r2(slope_beyond_current),
+    "max_slope_mb_per_min": max_slope,
+    "map_mem_end_mb": round(map_mb(rows[-1]), 2) if rows else None,
+    "map_points_end": int(rows[-1]["map_points"]) if rows else 0,
+    "map_points_max": max((int(r["map_points"]) for r in rows), default=0),
+    "map_keyframes_max": max((int(r["map_keyframes"]) for r in rows), default=0),
+    "occupancy_mem_mb_end": round(float(rows[-1]["occupancy_mem_bytes"]) / MB, 2) if rows else None,
+    "map_points_growth_per_min_2nd_half": r2(growth("map_points")),
+    "map_bounded": bool(rows) and bounded("map_points") and bounded("occupancy_mem_bytes"),
+    "map_points_max_halves": [half_max("map_points", first_half), half_max("map_points", half)],
+    "occupancy_mem_mb_max_halves": [round(half_max("occupancy_mem_bytes", first_half) / MB, 2),
+                                     round(half_max("occupancy_mem_bytes", half) / MB, 2)],
+    "occupancy_mem_growth_mb_per_min_2nd_half": r2(None if growth("occupancy_mem_bytes") is None else growth("occupancy_mem_bytes") / MB),
+    "frames": frames, "frames_received": received, "frames_dropped": dropped,
+    "service_alive_at_end": bool(alive), "service_exit": exit_code,
+    "asan": bool(asan), "lsan_leaks": leaks, "rss_slope_judged": asan != 1, "passed": ok,
+}
+print(f"soak ({scenario}, {duration:.1f} min{', ASan/LSan' if asan else ''}): RSS {out['rss_start_mb']} -> "
+      f"{out['rss_end_mb']} MB (max {out['rss_max_mb']}); slope {out['rss_slope_mb_per_min']} MB/min, retained "
+      f"{out['rss_retained_slope_mb_per_min']}, of which the map {out['map_mem_slope_mb_per_min']} and the "
+      f"trajectories {out['trajectory_mem_slope_mb_per_min']}: "
+      f"beyond the map's high-water mark {out['rss_slope_beyond_map_mb_per_min']} MB/min "
+      f"({'limit ' + str(max_slope) if asan != 1 else 'not judged under ASan: quarantine'})")
+print(f"  map at the end {out['map_mem_end_mb']} MB: {out['map_points_end']} points (max {out['map_points_max']}), "
+      f"{out['map_keyframes_max']} keyframes max, OcTree {out['occupancy_mem_mb_end']} MB; second half: points "
+      f"{out['map_points_growth_per_min_2nd_half']}/min, OcTree {out['occupancy_mem_growth_mb_per_min_2nd_half']} MB/min; "
+      f"largest first / second half: points {out['map_points_max_halves']}, OcTree {out['occupancy_mem_mb_max_halves']} MB"
+      f" ({'bounded' if out['map_bounded'] else 'NOT bounded'})")
+print(f"  frames processed {frames} of {received} received ({dropped} dropped as stale)")
+if asan:
+    print(f"  LeakSanitizer: {leaks} leak reports")
+print(f"  service exit {exit_code}, {'PASSED' if ok else 'FAILED'}")
+print(json.dumps(out))
+sys.exit(0 if ok else 1)
