@@ -224,6 +224,14 @@ DepthBound PerceptionCore::DepthBoundFor(int64_t track_id, const Eigen::Vector2d
   return bound;
 }
 
+void PerceptionCore::CountOccupancyCrops() {
+  if (!occupancy_ || occupancy_->crops() == occupancy_crops_counted_) return;
+  counters_->Increment(counter::kOccupancyCrops, occupancy_->crops() - occupancy_crops_counted_);
+  counters_->Increment(counter::kOccupancyVoxelsDropped, occupancy_->occupied_voxels_dropped() - occupancy_dropped_counted_);
+  occupancy_crops_counted_ = occupancy_->crops();
+  occupancy_dropped_counted_ = occupancy_->occupied_voxels_dropped();
+}
+
 void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime, double focal_px,
                                      const std::vector<std::vector<Eigen::Vector2d>>& moving_hulls_xy,
                                      FrameResult* result) {
@@ -232,13 +240,18 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
   const OccupancyMap::Units units = slam_.metric() ? OccupancyMap::Units::kMetres : OccupancyMap::Units::kUpToScale;
   if (update.rescaled_by && occupancy_) {
     const Status s = occupancy_->Rescale(*update.rescaled_by, units);
+    CountOccupancyCrops();  // the rebuild applies the memory bound too
     if (!s.ok()) {
       MBSLAM_LOG(WARNING) << "occupancy rescale: " << s.message() << "; starting a new occupancy map";
       occupancy_.reset();
     }
   }
   if (!update.new_keyframe || update.new_point_ids.empty()) return;
-  if (!occupancy_) occupancy_ = std::make_unique<OccupancyMap>(options_.occupancy, units);
+  if (!occupancy_) {
+    occupancy_ = std::make_unique<OccupancyMap>(options_.occupancy, units);
+    occupancy_crops_counted_ = 0;
+    occupancy_dropped_counted_ = 0;
+  }
   const Keyframe* kf = slam_.map().LastKeyframe();
   if (kf == nullptr) return;
   // Rays from the keyframe's camera centre to the points triangulated there (sec. 6.3);
@@ -248,8 +261,6 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
   for (int64_t id : update.new_point_ids) {
     if (const MapPoint* p = slam_.map().point(id)) points.push_back(p->position);
   }
-  const int64_t crops_before = occupancy_->crops();
-  const int64_t dropped_before = occupancy_->occupied_voxels_dropped();
   const Eigen::Vector3d center = kf->cam_from_world.Inverse().translation;
   // Interpolated rays (dense_rays.h): inside the image triangulation of every static
   // point the keyframe sees, sampled at the map's voxel size (so only once it is fixed:
@@ -295,10 +306,7 @@ void PerceptionCore::UpdateOccupancy(const SlamMapUpdate& update, int64_t utime,
     occupancy_->InsertRays(center, points);
     if (dense.enabled && occupancy_->IsResolutionFixed()) occupancy_->InsertRays(center, {}, interpolated());
   }
-  if (occupancy_->crops() > crops_before) {
-    counters_->Increment(counter::kOccupancyCrops, occupancy_->crops() - crops_before);
-    counters_->Increment(counter::kOccupancyVoxelsDropped, occupancy_->occupied_voxels_dropped() - dropped_before);
-  }
+  CountOccupancyCrops();
   if (!occupancy_->IsResolutionFixed()) return;
   // Serialising a large tree costs tens of ms: publish at most once per period.
   if (last_occupancy_publish_utime_ && utime - *last_occupancy_publish_utime_ < options_.occupancy_publish_period_us) return;

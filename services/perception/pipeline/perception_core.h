@@ -139,6 +139,8 @@ class PerceptionCore : public FrameProcessor {
   // image triangulation of all static points it sees (not across `moving_hulls_xy`, the
   // moving objects' outlines in normalised coordinates); the tree re-published when it
   // changed.
+  // Adds the memory-bound crops of the occupancy map not counted yet to the counters.
+  void CountOccupancyCrops();
   void UpdateOccupancy(const SlamMapUpdate& update, int64_t utime, double focal_px,
                        const std::vector<std::vector<Eigen::Vector2d>>& moving_hulls_xy, FrameResult* result);
   // SLAM's depth bound of a track, capped by where its ray meets the ground.
@@ -169,6 +171,8 @@ class PerceptionCore : public FrameProcessor {
   std::optional<GroundPlane> ground_;
   ObjectTracking object_tracking_;
   std::unique_ptr<OccupancyMap> occupancy_;  // static world only (sec. 6.3); null until rays arrive
+  int64_t occupancy_crops_counted_ = 0;    // occupancy_->crops() already on the counters
+  int64_t occupancy_dropped_counted_ = 0;  // occupancy_->occupied_voxels_dropped() already counted
   std::optional<int64_t> last_occupancy_publish_utime_;
   int64_t last_map_publish_frame_ = -1000000;
   std::vector<cv::Mat> pyramid_;

@@ -77,6 +77,13 @@ void SlamSystem::Reset() {
   unposed_.clear();
 }
 
+void SlamSystem::RestartMap(std::optional<Bridge> bridge) {
+  auto unposed = std::move(unposed_);
+  Reset();
+  bridge_ = std::move(bridge);
+  unposed_ = std::move(unposed);
+}
+
 Status SlamSystem::SaveMap(const std::string& path) {
   Flush();
   return map_.Save(path);
@@ -230,11 +237,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     const double ratio = static_cast<double>(est.num_inliers) / static_cast<double>(X.size());
     if (ratio < options_.init_confirm_inlier_ratio) {
       MBSLAM_LOG(INFO) << "SLAM: new map not confirmed (inlier share " << ratio << "); retrying";
-      const std::optional<Bridge> keep = bridge_;
-      auto unposed = std::move(unposed_);
-      Reset();
-      bridge_ = keep;
-      unposed_ = std::move(unposed);
+      RestartMap(bridge_);
       out.state = state_;
       RememberUnposed(frame);
       return out;
@@ -282,11 +285,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   } else {
     ++lost_frames_;
     if (state_ == SlamState::kConfirming) {
-      const std::optional<Bridge> keep = bridge_;
-      auto unposed = std::move(unposed_);
-      Reset();
-      bridge_ = keep;
-      unposed_ = std::move(unposed);
+      RestartMap(bridge_);
     } else {
       state_ = SlamState::kLost;
       if (lost_frames_ >= options_.lost_frames_to_reinit) {
@@ -303,10 +302,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
           b.metric = metric_;
           bridge = b;
         }
-        auto unposed = std::move(unposed_);
-        Reset();
-        bridge_ = bridge;
-        unposed_ = std::move(unposed);
+        RestartMap(bridge);
         just_initialized_ = true;
       }
     }

@@ -327,6 +327,9 @@ class SlamSystem {
   };
   std::optional<Bridge> bridge_;
   void ApplyBridge(int64_t ref_frame, int64_t cur_frame);
+  // Drops the map to initialise again, keeping `bridge` (the old world frame to continue)
+  // and the unposed images (their poses come from the next map).
+  void RestartMap(std::optional<Bridge> bridge);
 
   // Frustum depth grids per reference frame, rebuilt every image (the map changes).
   struct DepthGrid {
