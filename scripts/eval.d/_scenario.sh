@@ -12,7 +12,7 @@ eval_scenario() {
   local cam_height
   cam_height=$(awk '!/^#/ && NF >= 8 {s += $4; n++} END {if (n) printf "%.3f", s / n; else print 0}' "$seq/cam_trajectory.tum")
   run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/run" --set "objects.camera_height_m=$cam_height" ${SERVICE_ARGS:-}
-  local ate seg ate_nf="{}" occ="{}" obj="{}" obj05="{}"
+  local ate seg ate_nf="{}" occ="{}" obj="{}" obj05="{}" rec="{}"
   ate=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/run/result/camera_trajectory.tum" \
         --gt-sequence "$seq" --plot "$MBSLAM_EVAL_OUT/trajectory.png")
   seg=$(last_json "$MBSLAM_BIN/mbslam-eval-segmentation" --run "$MBSLAM_EVAL_OUT/run/out.lcmlog" --sequence "$seq" --name "$name")
@@ -26,6 +26,11 @@ eval_scenario() {
     obj05=$(last_json "$MBSLAM_BIN/mbslam-eval" objects --est-log "$MBSLAM_EVAL_OUT/run/out.lcmlog" \
           --gt-log "$seq/sequence.lcmlog" --horizon-us 500000 || echo "{}")
   fi
+  # Moving objects' own reconstructions (object_slam): camera-relative trajectory and shape.
+  if [[ -d "$MBSLAM_EVAL_OUT/run/result/reconstructions" ]]; then
+    rec=$(last_json "$MBSLAM_BIN/mbslam-eval" reconstructions --dir "$MBSLAM_EVAL_OUT/run/result/reconstructions" \
+          --gt-log "$seq/sequence.lcmlog" || echo "{}")
+  fi
   if [[ "${ABLATION:-0}" == "1" ]]; then
     run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/no_feedback" --set slam.use_segmentation=false \
       --set "objects.camera_height_m=$cam_height"
@@ -34,7 +39,7 @@ eval_scenario() {
   fi
   local len
   len=$(path_length "$seq/cam_trajectory.tum")
-  python3 - "$name" "$ate" "$seg" "$ate_nf" "$len" "$MBSLAM_EVAL_OUT/run/result/summary.json" "$occ" "$obj" "$obj05" "$cam_height" <<'PY'
+  python3 - "$name" "$ate" "$seg" "$ate_nf" "$len" "$MBSLAM_EVAL_OUT/run/result/summary.json" "$occ" "$obj" "$obj05" "$cam_height" "$rec" <<'PY'
 import json, sys
 name, ate, seg, ate_nf, length = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3]), json.loads(sys.argv[4]), float(sys.argv[5])
 summary = json.load(open(sys.argv[6]))
@@ -42,6 +47,7 @@ occ = json.loads(sys.argv[7])
 obj = json.loads(sys.argv[8] or "{}")
 obj05 = json.loads(sys.argv[9] or "{}")
 objs = obj.get("objects", [])
+rec = json.loads(sys.argv[11] or "{}")
 scales = [o["relative_scale_error"] for o in objs if o.get("settled_samples", 0) > 0]
 rmse = ate.get("ate_rmse_m")
 out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float(sys.argv[10]),
@@ -64,6 +70,12 @@ out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float
        "objects": [{k: o.get(k) for k in ("est_id", "name", "samples", "settled_samples", "pos_err_rel_settled_mean",
                                           "pos_err_rel_at_settle", "relative_scale_error", "volume_hit_rate",
                                           "volume_ratio_median")} for o in objs],
+       "object_reconstructions": rec.get("reconstructions"),
+       "object_traj_err_rel": rec.get("object_traj_err_rel"),
+       "object_shape_err_rel": rec.get("object_shape_err_rel"),
+       "object_shape_err_rel_median": rec.get("object_shape_err_rel_median"),
+       "object_reconstruction_images": rec.get("object_reconstruction_images"),
+       "object_reconstruction_body": rec.get("object_reconstruction_body"),
        "timings_ms": {k: v.get("mean_ms") for k, v in summary.get("timings", {}).items()}}
 if ate_nf:
     out["ate_rel_path_no_feedback"] = ate_nf["ate_rmse_m"] / length if ("ate_rmse_m" in ate_nf and length > 0) else None
@@ -77,6 +89,11 @@ if obj:
           f"error/range from 2 s {out['object_pos_err_rel_2s']}, relative scale error {out['relative_scale_error']}, "
           f"volumes hit +0.5 s {out['predicted_hit_rate_0_5s']} +1 s {out['predicted_hit_rate_1s']} "
           f"(median size x the true box: {out['predicted_volume_ratio_0_5s']} / {out['predicted_volume_ratio_1s']})")
+if rec.get("scored"):
+    print(f"  reconstructions: {rec.get('reconstructions')} ({rec.get('scored')} scored); the longest "
+          f"({rec.get('object_reconstruction_body')}, {rec.get('object_reconstruction_images')} images): camera-relative "
+          f"trajectory {pct(rec.get('object_traj_err_rel'))} of its path, shape {pct(rec.get('object_shape_err_rel'))} "
+          f"of the size (median {pct(rec.get('object_shape_err_rel_median'))})")
 if occ:
     print(f"  occupancy: precision {occ.get('occupancy_precision')}, recall {occ.get('occupancy_recall')} (voxel {occ.get('resolution_m')} m)")
 if ate_nf:

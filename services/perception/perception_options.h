@@ -55,6 +55,7 @@ struct PerceptionOptions {
   int64_t occupancy_publish_period_us = 1000000;
   int map_publish_every_frames = 15;
   ObjectTrackingOptions objects;
+  ObjectReconstructionOptions object_slam;
 
   CoreOptions core() const {
     CoreOptions c;
@@ -70,6 +71,7 @@ struct PerceptionOptions {
     c.occupancy_publish_period_us = occupancy_publish_period_us;
     c.map_publish_every_frames = map_publish_every_frames;
     c.objects = objects;
+    c.object_slam = object_slam;
     // Lockstep replays must be deterministic: bundle adjustment runs inline there.
     if (pipeline.lockstep()) c.slam.background_ba = false;
     c.wait_for_person_checks = pipeline.lockstep();
@@ -90,6 +92,7 @@ struct PerceptionOptions {
     MBSLAM_CHECK_OPTION_SECTION(ground);
     MBSLAM_CHECK_OPTION_SECTION(occupancy);
     MBSLAM_CHECK_OPTION_SECTION(objects);
+    MBSLAM_CHECK_OPTION_SECTION(object_slam);
     MBSLAM_CHECK_OPTION_GE(occupancy_publish_period_us, 0);
     MBSLAM_CHECK_OPTION_GE(map_publish_every_frames, 1);
     return true;
@@ -114,6 +117,7 @@ struct PerceptionOptions {
     v("map_publish_every_frames", &map_publish_every_frames,
       "PERCEPTION_MAP at least this often (frames), and at every keyframe");
     v("objects", &objects, "bearing-only tracking of moving objects, extent, predicted volumes (ch. 5-6)");
+    v("object_slam", &object_slam, "reconstruction of moving objects: one SLAM per chosen object (sec. 4.1)");
   }
 };
 

@@ -343,6 +343,7 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
       o.track_ids.insert(o.track_ids.end(), q.track_ids.begin(), q.track_ids.end());
       o.track_xy.insert(o.track_xy.end(), q.track_xy.begin(), q.track_xy.end());
       o.mapped_points.insert(o.mapped_points.end(), q.mapped_points.begin(), q.mapped_points.end());
+      if (!o.sfm && q.sfm) o.sfm = q.sfm;
       if (q.background_depth) {
         // The looser bound of the parts (each is the static depth behind its centroid).
         if (!o.background_depth || q.background_depth->max > o.background_depth->max) {
@@ -362,8 +363,35 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
     State& s = it->second;
     s.segment_id = o.id;
     bool restarted = false;
-    const Eigen::Vector2d ref = MoveReference(&s, o, &restarted);
+    Eigen::Vector2d ref = MoveReference(&s, o, &restarted);
     if (restarted && s.filter.initialized()) ++stats_.reference_restarts;
+    // With the object's reconstruction the reference is a point fixed in its map, placed
+    // on the followed bearing at the depth of the object's points when the map came; its
+    // projection is the bearing from then on (eq. 6.3: the filter needs that point).
+    std::optional<SfmObservation> sfm;
+    if (o.sfm && o.sfm->median_depth > 0.0 && o.sfm->cam_from_obj.IsFinite()) {
+      if (s.sfm_map_id != o.sfm->map_id) {
+        s.sfm_map_id = o.sfm->map_id;
+        s.reference_in_obj = o.sfm->cam_from_obj.Inverse() * (Eigen::Vector3d(ref.x(), ref.y(), 1.0) * o.sfm->median_depth);
+      }
+      const Eigen::Vector3d q = o.sfm->cam_from_obj * s.reference_in_obj;
+      Eigen::Vector2d lo = o.track_xy.front(), hi = o.track_xy.front();
+      for (const Eigen::Vector2d& p : o.track_xy) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+      const Eigen::Vector2d margin = 0.25 * (hi - lo);
+      const Eigen::Vector2d proj = q.z() > 0.0 ? Eigen::Vector2d(q.head<2>() / q.z()) : Eigen::Vector2d(1e9, 1e9);
+      if (q.z() > 0.0 && (proj.array() >= (lo - margin).array()).all() && (proj.array() <= (hi + margin).array()).all()) {
+        ref = proj;
+        sfm = SfmObservation{o.sfm->map_id, o.sfm->cam_from_obj, s.reference_in_obj};
+        ++stats_.sfm_observations;
+      } else {
+        // The map disagrees with the tracks: no feedback, and a new reference next time.
+        s.sfm_map_id = 0;
+        ++stats_.sfm_rejected;
+      }
+    }
     s.reference_xy = ref;
 
     FilterJob job;
@@ -379,6 +407,7 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
     b.xy = ref;
     b.track_xy = o.track_xy;
     b.ground_plane = frame.ground;
+    b.sfm = sfm;
     if (o.background_depth && std::isfinite(o.background_depth->max)) {
       b.depth_bound = DepthRange{0.0, o.background_depth->max * (1.0 + options_.depth_bound_margin)};
     }

@@ -161,6 +161,13 @@ struct ObjectObservation {
   std::vector<Eigen::Vector3d> mapped_points;
   // Mean image motion of its tracks per image (normalised); unset = unknown.
   std::optional<Eigen::Vector2d> flow_xy;
+  // The object's own reconstruction in this image (SfM feedback, eq. 6.3-6.4).
+  struct Sfm {
+    int64_t map_id = 0;
+    Rigid3d cam_from_obj;       // object map units
+    double median_depth = 0.0;  // camera depth of the object's points seen now (object units)
+  };
+  std::optional<Sfm> sfm;
 };
 
 struct ObjectFrame {
@@ -197,6 +204,8 @@ struct ObjectTrackingStats {
   int64_t segment_ids_forgotten = 0;  // segment id -> object id links unused for forget_after_us
   int64_t fragments_merged = 0;     // segments joined to an object seen in the same image
   int64_t fragments_split = 0;      // parts of an object that stopped agreeing with it
+  int64_t sfm_observations = 0;     // images an object's reconstruction was given to its filter
+  int64_t sfm_rejected = 0;         // reconstructions whose reference fell outside the object's tracks
 };
 
 class ObjectTracking {
@@ -225,6 +234,10 @@ class ObjectTracking {
     int64_t last_seen_utime = 0;
     int segment_id = 0;
     double metres_per_unit = 1.0;
+    // SfM feedback: the reference point fixed in the object's map when the map first
+    // came (its projection is then the bearing followed).
+    int64_t sfm_map_id = 0;
+    Eigen::Vector3d reference_in_obj = Eigen::Vector3d::Zero();
     State(const BearingOnlyTrackerOptions& f, const ObjectExtentOptions& e, int id)
         : filter(f, id), extent(e) {}
   };

@@ -88,6 +88,17 @@ struct ObjectOutput {
   std::vector<PredictedVolumeOutput> volumes;
 };
 
+// A moving object's own reconstruction (its SLAM) in one image, in the object's map
+// frame and units: for the trajectory files and evaluation.
+struct ObjectReconstructionOutput {
+  int object_id = 0;                    // persistent object id (as in ObjectOutput)
+  int64_t map_id = 0;                   // a new map (new scale) at every initialisation
+  Rigid3d cam_from_obj;                 // object map units
+  int num_points = 0;
+  bool points_included = false;         // `points` is the whole map (at its keyframes, periodically)
+  std::vector<Eigen::Vector3f> points;  // object frame (object map units)
+};
+
 struct KeyframeOutput {
   int64_t id = 0;
   int64_t utime = 0;
@@ -131,6 +142,7 @@ struct FrameResult {
   std::vector<TrackOutput> tracks;
   std::vector<HullOutput> hulls;
   std::vector<ObjectOutput> objects;
+  std::vector<ObjectReconstructionOutput> object_reconstructions;
   std::optional<MapOutput> map;
   std::optional<OccupancyOutput> occupancy;
   // The world frame's units changed in this image (e.g. to metres once odometry fixed

@@ -37,7 +37,9 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
       segmenter_(options.segmentation),
       person_detector_(options.person),
       slam_(options.slam),
-      object_tracking_(options.objects) {
+      object_tracking_(options.objects),
+      object_reconstruction_(std::make_unique<ObjectReconstruction>(options.object_slam, options.slam)),
+      object_slam_timer_(timers->Get("object_slam")) {
   const auto& q = options.odometry.base_from_cam_rotation;
   const auto& t = options.odometry.base_from_cam_translation;
   base_from_cam_ = Rigid3d(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), Eigen::Vector3d(t[0], t[1], t[2]));
@@ -49,6 +51,7 @@ void PerceptionCore::Reset() {
   occupancy_.reset();
   last_occupancy_publish_utime_.reset();
   object_tracking_.Reset();
+  object_reconstruction_ = std::make_unique<ObjectReconstruction>(options_.object_slam, options_.slam);
   tracker_.Reset();
   segmenter_.Reset();
   odometry_.Clear();
@@ -593,6 +596,31 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     t.p_static = static_cast<float>(it->second->p_static);
   }
 
+  // Each moving object with enough tracks gets its own SLAM (sec. 4.1): the camera w.r.t.
+  // the object and the object's points, in its own scale.
+  std::map<int, ObjectReconstructionResult> reconstruction_of;  // by segment id
+  if (options_.object_slam.enabled) {
+    ScopedStageTimer timer(object_slam_timer_);
+    std::unordered_map<int64_t, Eigen::Vector2d> xy_of;
+    for (const SlamObservation& so : slam_frame.observations) xy_of[so.track_id] = so.xy;
+    std::vector<ObjectTracksInput> inputs;
+    for (const SegmentedObject& o : seg.objects) {
+      ObjectTracksInput in;
+      in.id = o.id;
+      for (int64_t id : o.track_ids) {
+        auto it = xy_of.find(id);
+        if (it == xy_of.end()) continue;
+        in.track_ids.push_back(id);
+        in.xy.push_back(it->second);
+      }
+      if (!in.track_ids.empty()) inputs.push_back(std::move(in));
+    }
+    for (ObjectReconstructionResult& r :
+         object_reconstruction_->Update(frame_index_, frame.utime, 0.5 * (intrinsics.fx + intrinsics.fy), inputs)) {
+      reconstruction_of[r.id] = std::move(r);
+    }
+  }
+
   // Bearing-only tracking of every moving object (ch. 5-6).
   std::map<int, const TrackedObject*> tracked_of;
   const std::vector<TrackedObject>* tracked = nullptr;
@@ -630,6 +658,10 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
         ob.background_depth = DepthRange{0.0, b.z_max * f};
       }
       if (o.mean_flow_px.allFinite()) ob.flow_xy = o.mean_flow_px / of.focal_px;
+      auto rc = reconstruction_of.find(o.id);
+      if (options_.object_slam.feedback_to_tracker && rc != reconstruction_of.end() && rc->second.valid) {
+        ob.sfm = ObjectObservation::Sfm{rc->second.map_id, rc->second.cam_from_obj, rc->second.median_depth};
+      }
       auto mp = mapped_points_of.find(o.id);
       if (mp != mapped_points_of.end()) {
         ob.mapped_points = mp->second;
@@ -729,6 +761,35 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       record.person_checked_frame = frame_index_;
     }
     out.object_class = record.is_person ? ObjectClass::kPerson : ObjectClass::kUnknown;
+    // The object's own reconstruction (from its largest segment that has one): its points
+    // enter the world at the relative scale (sec. 6.1) once the filter has it.
+    for (const SegmentedObject* o : parts) {
+      auto rc = reconstruction_of.find(o->id);
+      if (rc == reconstruction_of.end() || !rc->second.valid) continue;
+      const ObjectReconstructionResult& r = rc->second;
+      ObjectReconstructionOutput ro;
+      ro.object_id = oid;
+      ro.map_id = r.map_id;
+      ro.cam_from_obj = r.cam_from_obj;
+      ro.num_points = r.num_points;
+      if (r.points_included) {
+        ro.points_included = true;
+        ro.points.reserve(r.points.size());
+        for (const Eigen::Vector3d& p : r.points) ro.points.push_back(p.cast<float>());
+        record.sfm_map_id = r.map_id;
+        record.sfm_points = r.points;
+      }
+      if (out.relative_scale > 0.0 && record.sfm_map_id == r.map_id && slam_pose.valid) {
+        out.state = ObjectState::kReconstructed;
+        const Rigid3d world_from_cam = result.camera_pose.world_from_cam;
+        out.points.reserve(record.sfm_points.size());
+        for (const Eigen::Vector3d& p : record.sfm_points) {
+          out.points.push_back((world_from_cam * (out.relative_scale * (r.cam_from_obj * p))).cast<float>());
+        }
+      }
+      result.object_reconstructions.push_back(std::move(ro));
+      break;
+    }
     out.hull = hull;
     result.hulls.push_back(hull);
     result.objects.push_back(std::move(out));

@@ -26,6 +26,7 @@
 #include "services/perception/pipeline/stage_timers.h"
 #include "services/perception/segmentation/motion_segmenter.h"
 #include "services/perception/segmentation/person_detector.h"
+#include "services/perception/slam/object_reconstruction.h"
 #include "services/perception/slam/slam_system.h"
 #include "services/perception/tracking/feature_tracker.h"
 
@@ -107,6 +108,7 @@ struct CoreOptions {
   bool occupancy_enabled = true;      // build and publish the static-world occupancy map
   int64_t occupancy_publish_period_us = 1000000;  // PERCEPTION_OCCUPANCY at most this often, at keyframes (µs)
   ObjectTrackingOptions objects;
+  ObjectReconstructionOptions object_slam;
   int map_publish_every_frames = 15;  // PERCEPTION_MAP at most this often, and at every keyframe
   // Person checks launched with one image are collected with the next: waiting for them
   // (lockstep: the same result every run) or, live, taking them when done and launching
@@ -128,7 +130,10 @@ class PerceptionCore : public FrameProcessor {
   const PoseBuffer& odometry() const { return odometry_; }
   const SlamSystem& slam() const { return slam_; }
   size_t num_object_records() const { return object_records_.size(); }
-  void Finish() override { slam_.Flush(); }
+  void Finish() override {
+    slam_.Flush();
+    object_reconstruction_->Flush();
+  }
 
  private:
   std::optional<RelativeMotion> OdometryMotion(int64_t ref_frame, int64_t cur_frame) const;
@@ -170,6 +175,8 @@ class PerceptionCore : public FrameProcessor {
   SlamSystem slam_;
   std::optional<GroundPlane> ground_;
   ObjectTracking object_tracking_;
+  std::unique_ptr<ObjectReconstruction> object_reconstruction_;
+  TimingStats* object_slam_timer_;
   std::unique_ptr<OccupancyMap> occupancy_;  // static world only (sec. 6.3); null until rays arrive
   int64_t occupancy_crops_counted_ = 0;    // occupancy_->crops() already on the counters
   int64_t occupancy_dropped_counted_ = 0;  // occupancy_->occupied_voxels_dropped() already counted
@@ -185,6 +192,8 @@ class PerceptionCore : public FrameProcessor {
     int64_t last_utime = 0;              // last reported
     std::optional<int64_t> person_checked_frame;  // frame of the last person check
     bool is_person = false;
+    int64_t sfm_map_id = 0;                   // the object's reconstruction whose points are below
+    std::vector<Eigen::Vector3d> sfm_points;  // its points (object frame, object units)
   };
   ObjectRecord& RecordOf(int id, int64_t utime);
   void ForgetGoneObjects(int64_t utime);

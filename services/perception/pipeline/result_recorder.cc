@@ -55,12 +55,21 @@ void ResultRecorder::OnFrameResult(const FrameResult& r) {
     objects_[o.id].push_back(TimedPose{r.utime, o.world_from_object});
     ++object_poses_;
   }
-  // Over the budget: the oldest objects' trajectories go first, whole.
-  while (object_poses_ > max_poses_ && objects_.size() > 1) {
-    const size_t n = objects_.begin()->second.size();
+  for (const ObjectReconstructionOutput& o : r.object_reconstructions) {
+    Reconstruction& rec = reconstructions_[{o.object_id, o.map_id}];
+    rec.obj_from_cam.push_back(TimedPose{r.utime, o.cam_from_obj.Inverse()});
+    if (o.points_included) rec.points = o.points;
+    ++object_poses_;
+  }
+  // Over the budget: the oldest objects' trajectories (and reconstructions) go first, whole.
+  while (object_poses_ > max_poses_ && (objects_.size() > 1 || reconstructions_.size() > 1)) {
+    const bool drop_object =
+        reconstructions_.empty() || (!objects_.empty() && objects_.begin()->first <= reconstructions_.begin()->first.first);
+    const size_t n = drop_object ? objects_.begin()->second.size() : reconstructions_.begin()->second.obj_from_cam.size();
     object_poses_ -= n;
     object_poses_dropped_ += static_cast<int64_t>(n);
-    objects_.erase(objects_.begin());
+    if (drop_object) objects_.erase(objects_.begin());
+    else reconstructions_.erase(reconstructions_.begin());
   }
   if (r.map) map_ = r.map;
   if (r.occupancy) occupancy_ = r.occupancy;
@@ -91,6 +100,22 @@ Status ResultRecorder::Write(const std::string& dir, const std::string& extra_su
     MBSLAM_RETURN_IF_ERROR(
         WriteStringAtomically(dir + "/objects/" + std::to_string(id) + ".tum", out.str()));
   }
+  if (!reconstructions_.empty()) {
+    ::mkdir((dir + "/reconstructions").c_str(), 0755);
+    RemoveStaleTempFiles(dir + "/reconstructions");
+  }
+  for (const auto& [key, rec] : reconstructions_) {
+    const std::string base = dir + "/reconstructions/" + std::to_string(key.first) + "_" + std::to_string(key.second);
+    std::ostringstream traj;
+    traj << "# object " << key.first << ", map " << key.second
+         << ": obj_from_cam (the camera in the object's own map, its units), TUM format\n";
+    for (const TimedPose& p : rec.obj_from_cam) traj << TumLine(p.utime, p.pose) << "\n";
+    MBSLAM_RETURN_IF_ERROR(WriteStringAtomically(base + ".tum", traj.str()));
+    std::ostringstream pts;
+    pts << "# object " << key.first << ", map " << key.second << ": points in the object's own map: x y z\n";
+    for (const Eigen::Vector3f& p : rec.points) pts << p.x() << " " << p.y() << " " << p.z() << "\n";
+    MBSLAM_RETURN_IF_ERROR(WriteStringAtomically(base + ".xyz", pts.str()));
+  }
   if (map_) {
     std::ostringstream out;
     out << "ply\nformat ascii 1.0\nelement vertex " << map_->points.size()
@@ -115,6 +140,7 @@ Status ResultRecorder::Write(const std::string& dir, const std::string& extra_su
        << ",\n  \"posed_fraction\": " << (frames_ ? double(tracked_ + backfilled_) / frames_ : 0.0)
        << ",\n  \"first_utime\": " << first_utime_ << ",\n  \"last_utime\": " << last_utime_
        << ",\n  \"objects_with_trajectory\": " << objects_.size()
+       << ",\n  \"object_reconstructions\": " << reconstructions_.size()
        << ",\n  \"map_points\": " << (map_ ? map_->points.size() : 0)
        << ",\n  \"occupied_voxels\": " << (occupancy_ ? occupancy_->num_occupied : 0)
        << ",\n  \"camera_poses_dropped\": " << camera_poses_dropped_

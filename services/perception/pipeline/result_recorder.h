@@ -46,6 +46,13 @@ class ResultRecorder : public OutputSink {
   size_t object_poses_ = 0;
   int64_t camera_poses_dropped_ = 0;
   int64_t object_poses_dropped_ = 0;
+  // Objects' own reconstructions, by (object id, map id): the camera in the object's map
+  // (obj_from_cam) per image and the latest points; counted with the object poses.
+  struct Reconstruction {
+    std::vector<TimedPose> obj_from_cam;
+    std::vector<Eigen::Vector3f> points;
+  };
+  std::map<std::pair<int, int64_t>, Reconstruction> reconstructions_;
   std::optional<MapOutput> map_;
   std::optional<OccupancyOutput> occupancy_;
   int64_t frames_ = 0;

@@ -1,0 +1,143 @@
+#include "services/perception/slam/object_reconstruction.h"
+
+#include <algorithm>
+#include <unordered_map>
+#include <utility>
+
+#include "common/util/logging.h"
+
+namespace mbslam {
+
+SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOptions& options,
+                                                    const SlamOptions& slam) {
+  SlamOptions s = slam;
+  s.enabled = true;
+  s.init_min_tracks = options.init_min_tracks;
+  s.init_min_points = options.init_min_points;
+  s.init_min_parallax_deg = options.init_min_parallax_deg;
+  s.min_tracking_inliers = options.min_tracking_inliers;
+  s.max_keyframes = options.max_keyframes;
+  // The object is the only motion its SLAM is given, and it covers a small part of the
+  // image: no motion selection, no coverage or hull tests.
+  s.init_max_motions = 1;
+  s.init_min_coverage = 0.0;
+  s.init_max_hull_share = 1.0;
+  // No odometry (it moves the camera, not the object), no images (guided matching), no
+  // back-filled poses, no map files.
+  s.use_odometry = false;
+  s.guided_matching = false;
+  s.backfill_max_frames = 0;
+  s.use_segmentation = true;
+  s.map_load_path.clear();
+  s.map_save_path.clear();
+  return s;
+}
+
+ObjectReconstruction::ObjectReconstruction(const ObjectReconstructionOptions& options, const SlamOptions& slam)
+    : options_(options), slam_options_(ObjectSlamOptions(options, slam)) {}
+
+ObjectReconstruction::~ObjectReconstruction() { Flush(); }
+
+void ObjectReconstruction::Flush() {
+  for (auto& [id, e] : entries_) e.slam->Flush();
+}
+
+std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t frame_index, int64_t utime,
+                                                                     double focal_px,
+                                                                     const std::vector<ObjectTracksInput>& objects) {
+  std::vector<ObjectReconstructionResult> results;
+  if (!options_.enabled || options_.max_objects == 0) return results;
+  // Forget the reconstructions of objects gone for a while.
+  for (auto it = entries_.begin(); it != entries_.end();) {
+    if (frame_index - it->second.last_seen_frame > options_.forget_after_frames) {
+      MBSLAM_LOG(INFO) << "object " << it->first << ": reconstruction dropped (unseen since frame "
+                       << it->second.last_seen_frame << ")";
+      it = entries_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  // New reconstructions: the objects with most tracks, while there is room.
+  std::vector<const ObjectTracksInput*> order;
+  for (const ObjectTracksInput& o : objects) order.push_back(&o);
+  std::stable_sort(order.begin(), order.end(), [](const ObjectTracksInput* a, const ObjectTracksInput* b) {
+    return a->track_ids.size() > b->track_ids.size();
+  });
+  for (const ObjectTracksInput* o : order) {
+    if (static_cast<int>(entries_.size()) >= options_.max_objects) break;
+    if (entries_.count(o->id) || static_cast<int>(o->track_ids.size()) < options_.min_tracks) continue;
+    Entry e;
+    e.slam = std::make_unique<SlamSystem>(slam_options_);
+    e.last_seen_frame = frame_index;
+    entries_.emplace(o->id, std::move(e));
+    MBSLAM_LOG(INFO) << "object " << o->id << ": reconstruction started (" << o->track_ids.size() << " tracks)";
+  }
+
+  for (const ObjectTracksInput* o : order) {
+    auto it = entries_.find(o->id);
+    if (it == entries_.end()) continue;
+    Entry& e = it->second;
+    e.last_seen_frame = frame_index;
+    SlamFrame frame;
+    frame.frame_index = frame_index;
+    frame.utime = utime;
+    frame.focal_px = focal_px;
+    std::unordered_map<int64_t, int> labels;
+    frame.observations.reserve(o->track_ids.size());
+    for (size_t i = 0; i < o->track_ids.size() && i < o->xy.size(); ++i) {
+      SlamObservation so;
+      so.track_id = o->track_ids[i];
+      so.xy = o->xy[i];
+      so.uv = o->xy[i] * focal_px;
+      so.body_id = 0;  // static w.r.t. the object
+      so.p_static = 1.0;
+      frame.observations.push_back(so);
+      labels[so.track_id] = 0;
+    }
+    const SlamPose pose = e.slam->TrackPose(frame);
+    const SlamMapUpdate update = e.slam->UpdateMap(frame, labels);
+    // A map lives from its first valid pose until its SLAM starts again (a loss keeps
+    // it; a re-initialisation is a new map with a new, unrelated scale).
+    const SlamState state = e.slam->state();
+    if (state == SlamState::kNotInitialized || state == SlamState::kInitializing) e.map_active = false;
+    ObjectReconstructionResult r;
+    r.id = o->id;
+    if (pose.valid && !e.map_active) {
+      e.map_active = true;
+      e.map_id = next_map_id_++;
+      ++maps_started_;
+      e.last_points_frame = -1;
+      MBSLAM_LOG(INFO) << "object " << o->id << ": reconstructed, map " << e.map_id << " ("
+                       << e.slam->map().num_points() << " points)";
+    }
+    r.map_id = e.map_id;
+    r.valid = pose.valid && e.map_active;
+    r.num_points = static_cast<int>(e.slam->map().num_points());
+    if (r.valid) {
+      r.cam_from_obj = pose.cam_from_world;
+      r.num_inliers = pose.num_inliers;
+      std::vector<double> z;
+      for (const SlamObservation& so : frame.observations) {
+        const int64_t pid = e.slam->map().PointOfTrack(so.track_id);
+        if (pid < 0) continue;
+        const double d = (r.cam_from_obj * e.slam->map().point(pid)->position).z();
+        if (d > 0.0) z.push_back(d);
+      }
+      if (!z.empty()) {
+        std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+        r.median_depth = z[z.size() / 2];
+      }
+      if (update.new_keyframe || e.last_points_frame < 0 ||
+          frame_index - e.last_points_frame >= options_.points_every_frames) {
+        r.points_included = true;
+        r.points.reserve(e.slam->map().num_points());
+        for (const auto& [pid, p] : e.slam->map().points()) r.points.push_back(p.position);
+        e.last_points_frame = frame_index;
+      }
+    }
+    results.push_back(std::move(r));
+  }
+  return results;
+}
+
+}  // namespace mbslam

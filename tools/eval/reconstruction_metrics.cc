@@ -1,0 +1,130 @@
+#include "tools/eval/reconstruction_metrics.h"
+
+#include <dirent.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "tools/eval/alignment.h"
+#include "tools/eval/point_metrics.h"
+
+namespace mbslam {
+namespace eval {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+double Rms(const std::vector<double>& v) {
+  if (v.empty()) return 0.0;
+  double s = 0.0;
+  for (double x : v) s += x * x;
+  return std::sqrt(s / static_cast<double>(v.size()));
+}
+
+}  // namespace
+
+double BoxSurfaceDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent) {
+  const Eigen::Vector3d q = p.cwiseAbs() - 0.5 * extent;
+  const double outside = q.cwiseMax(0.0).norm();
+  const double inside = std::min(q.maxCoeff(), 0.0);
+  return outside > 0.0 ? outside : -inside;
+}
+
+Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<int, BodyTruth>& truth,
+                              const Trajectory& gt_world_from_cam, int64_t max_time_diff_us, int min_samples,
+                              ReconstructionResult* result) {
+  bool found = false;
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& [id, body] : truth) {
+    std::vector<Rigid3d> src, dst;
+    for (const TimedPose& e : est.obj_from_cam) {
+      Rigid3d world_from_cam, world_from_body;
+      if (!InterpolatePose(gt_world_from_cam, e.utime, max_time_diff_us, &world_from_cam)) continue;
+      if (!InterpolatePose(body.poses, e.utime, max_time_diff_us, &world_from_body)) continue;
+      src.push_back(e.pose);
+      dst.push_back(world_from_body.Inverse() * world_from_cam);
+    }
+    if (static_cast<int>(src.size()) < min_samples) continue;
+    Sim3d body_from_map;
+    if (!OrientationAlignment(src, dst, /*with_scale=*/true, &body_from_map).ok()) continue;
+    std::vector<double> err;
+    double path = 0.0, range = 0.0;
+    for (size_t i = 0; i < src.size(); ++i) {
+      err.push_back((body_from_map * src[i].translation - dst[i].translation).norm());
+      range += dst[i].translation.norm();
+      if (i > 0) path += (dst[i].translation - dst[i - 1].translation).norm();
+    }
+    range /= static_cast<double>(src.size());
+    const double rmse = Rms(err);
+    if (!(range > 0.0) || rmse / range >= best) continue;
+    best = rmse / range;
+    found = true;
+    ReconstructionResult& r = *result;
+    r = ReconstructionResult();
+    r.object_id = est.object_id;
+    r.map_id = est.map_id;
+    r.gt_id = id;
+    r.gt_name = body.name;
+    r.samples = static_cast<int>(src.size());
+    r.scale = body_from_map.scale;
+    r.path_length_m = path;
+    r.mean_range_m = range;
+    r.trajectory_rmse_m = rmse;
+    r.trajectory_err_rel_path = path > 0.0 ? rmse / path : std::numeric_limits<double>::infinity();
+    r.trajectory_err_rel_range = rmse / range;
+    r.size_m = body.extent.maxCoeff();
+    std::vector<double> d;
+    int within = 0;
+    for (const Eigen::Vector3d& p : est.points) {
+      d.push_back(BoxSurfaceDistance(body_from_map * p, body.extent));
+      within += d.back() <= 0.02 * r.size_m;
+    }
+    r.num_points = static_cast<int>(d.size());
+    r.shape_rmse_m = Rms(d);
+    r.shape_median_m = Median(d);
+    if (r.size_m > 0.0) {
+      r.shape_err_rel = r.shape_rmse_m / r.size_m;
+      r.shape_err_rel_median = r.shape_median_m / r.size_m;
+    }
+    r.share_within_2pct = d.empty() ? 0.0 : static_cast<double>(within) / static_cast<double>(d.size());
+  }
+  if (!found) return Status::Error("reconstruction of object " + std::to_string(est.object_id) + " map " +
+                                   std::to_string(est.map_id) + ": no body with enough common samples");
+  return Status::Ok();
+}
+
+Status ReadReconstructions(const std::string& dir, std::vector<ReconstructionEstimate>* out) {
+  out->clear();
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) return Status::Error("cannot open " + dir);
+  std::vector<std::string> names;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string name = e->d_name;
+    if (name.size() > 4 && name.compare(name.size() - 4, 4, ".tum") == 0) names.push_back(name.substr(0, name.size() - 4));
+  }
+  ::closedir(d);
+  std::sort(names.begin(), names.end());
+  for (const std::string& base : names) {
+    ReconstructionEstimate r;
+    const size_t us = base.find('_');
+    if (us == std::string::npos) return Status::Error("reconstruction file name not <object>_<map>: " + base);
+    try {
+      r.object_id = std::stoi(base.substr(0, us));
+      r.map_id = std::stoll(base.substr(us + 1));
+    } catch (...) {
+      return Status::Error("reconstruction file name not <object>_<map>: " + base);
+    }
+    MBSLAM_RETURN_IF_ERROR(ReadTumTrajectory(dir + "/" + base + ".tum", &r.obj_from_cam));
+    MBSLAM_RETURN_IF_ERROR(ReadPointsFile(dir + "/" + base + ".xyz", &r.points));
+    out->push_back(std::move(r));
+  }
+  return Status::Ok();
+}
+
+}  // namespace eval
+}  // namespace mbslam
