@@ -417,6 +417,17 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     hints.occluders = occluders_;
     tracker_.TrackFrame(pyramid_, frame_index_, hints);
   }
+  if (tracker_.stats().rejected) {
+    // A glitch image (flash, corrupted or foreign frame): no pose and no change to any
+    // state; the next image is tracked from the last good one.
+    MBSLAM_LOG(WARNING) << "image " << frame.seq << " rejected as a glitch: " << tracker_.stats().established_matched
+                        << " of " << tracker_.stats().established << " established tracks matched";
+    counters_->Increment(counter::kImageRejectedGlitch);
+    frame_utime_.erase(frame_index_);
+    --frame_index_;
+    result.camera_pose.tracking_state = slam_.initialized() ? TrackingState::kLost : TrackingState::kNotInitialized;
+    return result;
+  }
 
   // SLAM, step 1: the camera pose against the static map, with the previous labels.
   const CameraIntrinsics& intrinsics = *frame.intrinsics;

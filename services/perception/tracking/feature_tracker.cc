@@ -21,6 +21,7 @@ void FeatureTracker::Reset() {
   tracks_.clear();
   recently_lost_.clear();
   prev_pyramid_.clear();
+  last_rejected_ = false;
 }
 
 namespace {
@@ -91,6 +92,9 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   }
 
   const float border = static_cast<float>(options_.border_px);
+  // Kept to undo this image if it turns out to be a glitch (shallow copies of patches).
+  std::vector<Track> before;
+  if (options_.glitch_max_survival > 0.0 && !last_rejected_) before = tracks_;
   std::vector<Track> next_tracks;
   next_tracks.reserve(tracks_.size() + 64);
   std::vector<size_t> klt_index;  // into tracks_
@@ -206,6 +210,10 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     const bool matched = ok && ExtractPatch(image, next, options_.patch_size, &patch) &&
                          (t.patch.empty() || PatchNcc(patch, t.patch) >= options_.min_patch_ncc) &&
                          (t.anchor.empty() || PatchNcc(patch, t.anchor) >= options_.min_anchor_ncc);
+    if (t.age >= 3) {
+      ++stats_.established;
+      stats_.established_matched += matched;
+    }
     if (!matched) {
       // A failed match of a static track predicted behind a moving object's hull is an
       // occlusion (thesis sec. 2.2 c): keep it, unmatched, until it reappears.
@@ -236,6 +244,23 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     ++stats_.tracked;
     next_tracks.push_back(std::move(t));
   }
+
+  // A glitch image: nearly every established track lost at once. Undo, keep the last
+  // good image as the reference.
+  if (options_.glitch_max_survival > 0.0 && !last_rejected_ && stats_.established >= options_.glitch_min_tracks &&
+      static_cast<double>(stats_.established_matched) <
+          options_.glitch_max_survival * static_cast<double>(stats_.established)) {
+    const TrackerStats seen = stats_;
+    tracks_ = std::move(before);
+    recently_lost_.clear();
+    stats_ = TrackerStats();
+    stats_.rejected = true;
+    stats_.established = seen.established;
+    stats_.established_matched = seen.established_matched;
+    last_rejected_ = true;
+    return;
+  }
+  last_rejected_ = false;
 
   // Wide baseline: when KLT kept too few, ORB descriptors re-match the lost tracks.
   if (options_.descriptor_fallback && !prev_pts.empty() &&

@@ -50,6 +50,11 @@ struct TrackerOptions {
   int fallback_max_hamming = 50;       // descriptor acceptance (bits)
   double fallback_ratio = 0.8;         // Lowe ratio test
   double fallback_radius = 0.35;       // search radius (fraction of the image diagonal)
+  // A glitch image (a flash, a corrupted or foreign frame) loses nearly every established
+  // track at once: the image is rejected, the tracks are kept and the next image is
+  // tracked from the last good one. Not twice in a row (a real change of view is taken).
+  double glitch_max_survival = 0.2;    // established tracks matched below this share: glitch (0 = off)
+  int glitch_min_tracks = 40;          // ... only with at least this many established tracks (count)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(max_features, 0);
@@ -80,6 +85,8 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION(fallback_max_hamming > 0 && fallback_max_hamming <= 256);
     MBSLAM_CHECK_OPTION(fallback_ratio > 0.0 && fallback_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GT(fallback_radius, 0.0);
+    MBSLAM_CHECK_OPTION(glitch_max_survival >= 0.0 && glitch_max_survival < 1.0);
+    MBSLAM_CHECK_OPTION_GE(glitch_min_tracks, 1);
     return true;
   }
   template <typename V>
@@ -112,6 +119,9 @@ struct TrackerOptions {
     v("fallback_max_hamming", &fallback_max_hamming, "ORB acceptance distance (bits)");
     v("fallback_ratio", &fallback_ratio, "Lowe ratio test of the fallback");
     v("fallback_radius", &fallback_radius, "fallback search radius (fraction of the diagonal)");
+    v("glitch_max_survival", &glitch_max_survival,
+      "established tracks matched below this share: the image is a glitch, rejected, tracks kept (0 = off)");
+    v("glitch_min_tracks", &glitch_min_tracks, "glitch test only with this many established tracks (count)");
   }
 };
 
@@ -136,6 +146,9 @@ struct TrackerStats {
   int created = 0;        // new features
   int rejected_unicity = 0;
   int descriptor_matched = 0;  // recovered by the ORB fallback
+  bool rejected = false;       // the image was a glitch (see glitch_max_survival): nothing changed
+  int established = 0;         // tracks of age >= 3 tried in this image
+  int established_matched = 0;
 };
 
 class FeatureTracker {
@@ -179,6 +192,7 @@ class FeatureTracker {
   int64_t next_id_ = 1;
   int64_t frame_index_ = -1;
   TrackerStats stats_;
+  bool last_rejected_ = false;  // the previous image was rejected as a glitch
 };
 
 }  // namespace mbslam

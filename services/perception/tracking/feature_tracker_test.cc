@@ -124,6 +124,49 @@ TEST(FeatureTracker, InconsistentMatchesAreDropped) {
   EXPECT_LT(survivors, static_cast<int>(before / 10)) << "of " << before;
 }
 
+// A glitch image (here an unrelated one) between good images: rejected, the tracks kept
+// as they were, and the next image tracked from the last good one. Two in a row are a real
+// change of view: the second is taken.
+TEST(FeatureTracker, GlitchImageIsRejectedAndTracksSurviveIt) {
+  FeatureTracker tracker(TrackerOptions{});
+  const cv::Mat base = Texture(320, 240, 5);
+  for (int f = 0; f < 4; ++f) tracker.TrackFrame(Pyramid(Shift(base, f, 0)), f, {});
+  EXPECT_FALSE(tracker.stats().rejected);
+  std::map<int64_t, Eigen::Vector2f> before;
+  for (const Track& t : tracker.tracks()) before[t.id] = t.uv;
+  ASSERT_GT(before.size(), 100u);
+  tracker.TrackFrame(Pyramid(Texture(320, 240, 77)), 4, {});
+  EXPECT_TRUE(tracker.stats().rejected);
+  EXPECT_GE(tracker.stats().established, 100);
+  ASSERT_EQ(tracker.tracks().size(), before.size());
+  for (const Track& t : tracker.tracks()) {
+    ASSERT_TRUE(before.count(t.id));
+    EXPECT_EQ(t.uv, before[t.id]) << "a rejected image changes no track";
+  }
+  // The next good image (two steps on from the last good one) is tracked from it.
+  tracker.TrackFrame(Pyramid(Shift(base, 5, 0)), 5, {});
+  EXPECT_FALSE(tracker.stats().rejected);
+  int followed = 0;
+  for (const Track& t : tracker.tracks()) {
+    auto it = before.find(t.id);
+    if (it != before.end() && std::abs(t.uv.x() - it->second.x() - 2.0f) < 0.3f) ++followed;
+  }
+  EXPECT_GT(followed, static_cast<int>(0.8 * before.size()));
+  // Two unrelated images in a row: the first is rejected, the second taken.
+  for (int f = 6; f < 9; ++f) tracker.TrackFrame(Pyramid(Shift(base, f, 0)), f, {});
+  tracker.TrackFrame(Pyramid(Texture(320, 240, 78)), 9, {});
+  EXPECT_TRUE(tracker.stats().rejected);
+  tracker.TrackFrame(Pyramid(Texture(320, 240, 79)), 10, {});
+  EXPECT_FALSE(tracker.stats().rejected);
+  // Off: never rejected.
+  TrackerOptions off;
+  off.glitch_max_survival = 0.0;
+  FeatureTracker plain(off);
+  for (int f = 0; f < 4; ++f) plain.TrackFrame(Pyramid(Shift(base, f, 0)), f, {});
+  plain.TrackFrame(Pyramid(Texture(320, 240, 77)), 4, {});
+  EXPECT_FALSE(plain.stats().rejected);
+}
+
 TEST(FeatureTracker, GuidedMatchRecoversLostTracksNearPrediction) {
   FeatureTracker tracker(TrackerOptions{});
   const cv::Mat base = Texture(640, 480, 5);
