@@ -405,7 +405,9 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     // A fresh pyramid every image: the tracker keeps the previous one (shallow Mats),
     // so buffers must not be reused.
     pyramid_ = std::vector<cv::Mat>();
-    cv::buildOpticalFlowPyramid(frame.gray, pyramid_, cv::Size(21, 21),
+    // The pyramid's border must hold the KLT window (OpenCV asserts otherwise).
+    const int border_win = std::max(21, options_.tracking.klt_window_px);
+    cv::buildOpticalFlowPyramid(frame.gray, pyramid_, cv::Size(border_win, border_win),
                                 options_.preprocess.pyramid_levels - 1);
   }
 
