@@ -406,7 +406,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     // so buffers must not be reused.
     pyramid_ = std::vector<cv::Mat>();
     // The pyramid's border must hold the KLT window (OpenCV asserts otherwise).
-    const int border_win = std::max(21, options_.tracking.klt_window_px);
+    const int border_win = std::max({21, options_.tracking.klt_window_px, options_.tracking.klt_fast_window_px});
     cv::buildOpticalFlowPyramid(frame.gray, pyramid_, cv::Size(border_win, border_win),
                                 options_.preprocess.pyramid_levels - 1);
   }

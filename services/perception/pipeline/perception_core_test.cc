@@ -45,10 +45,11 @@ cv::Mat Shifted(const cv::Mat& img, double dx) {
   return out;
 }
 
-// A KLT window wider than the pyramid's default border (21) used to abort in OpenCV.
+// KLT windows wider than the pyramid's default border (21) used to abort in OpenCV.
 TEST(PerceptionCoreTest, WideKltWindowRuns) {
   CoreOptions options;
   options.tracking.klt_window_px = 31;
+  options.tracking.klt_fast_window_px = 35;
   options.slam.background_ba = false;
   ASSERT_TRUE(options.tracking.Check());
   Counters counters;

@@ -22,6 +22,7 @@ void FeatureTracker::Reset() {
   recently_lost_.clear();
   prev_pyramid_.clear();
   last_rejected_ = false;
+  last_median_flow_px_ = 0.0;
 }
 
 namespace {
@@ -137,10 +138,12 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   }
 
   // Stage 1: KLT from the predicted positions, forward then backward.
-  const cv::Size win(options_.klt_window_px, options_.klt_window_px);
+  stats_.fast_motion = options_.klt_fast_flow_px > 0.0 && last_median_flow_px_ > options_.klt_fast_flow_px;
+  const int win_px = stats_.fast_motion ? options_.klt_fast_window_px : options_.klt_window_px;
+  const cv::Size win(win_px, win_px);
   const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                               options_.klt_max_iterations, options_.klt_epsilon);
-  const int max_level = options_.klt_levels - 1;
+  const int max_level = (stats_.fast_motion ? options_.klt_fast_levels : options_.klt_levels) - 1;
   std::vector<uint8_t> status, back_status;
   std::vector<float> err;
   std::vector<cv::Point2f> back_pts;
@@ -261,6 +264,18 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     return;
   }
   last_rejected_ = false;
+  {
+    std::vector<float> flows;
+    flows.reserve(next_tracks.size());
+    for (const Track& t : next_tracks) {
+      if (t.status == TrackStatus::kActive && t.last_seen_frame == frame_index) flows.push_back((t.uv - t.prev_uv).norm());
+    }
+    if (!flows.empty()) {
+      std::nth_element(flows.begin(), flows.begin() + flows.size() / 2, flows.end());
+      last_median_flow_px_ = flows[flows.size() / 2];
+    }
+    stats_.median_flow_px = last_median_flow_px_;
+  }
 
   // Wide baseline: when KLT kept too few, ORB descriptors re-match the lost tracks.
   if (options_.descriptor_fallback && !prev_pts.empty() &&

@@ -32,6 +32,12 @@ struct TrackerOptions {
   int klt_window_px = 15;              // KLT window side (px)
   int klt_levels = 3;                  // pyramid levels used by KLT (count)
   int klt_backward_levels = 3;         // levels of the backward (consistency) pass; fewer are faster but let more false matches through (count)
+  // Fast image motion (low frame rate, quick turns): when the tracks moved more than
+  // klt_fast_flow_px (median) in the previous image, KLT uses a wider window and more
+  // levels for this one (0 = off).
+  double klt_fast_flow_px = 10.0;      // median track motion that switches to the fast settings (px)
+  int klt_fast_window_px = 21;         // KLT window under fast motion (px)
+  int klt_fast_levels = 4;             // KLT pyramid levels under fast motion (count; <= preprocess.pyramid_levels)
   int klt_max_iterations = 12;         // KLT iterations per level (count)
   int klt_threads = 2;                 // KLT points split over this many threads (identical result; count)
   double klt_epsilon = 0.05;           // KLT convergence (px)
@@ -67,6 +73,9 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION_GE(klt_window_px, 5);
     MBSLAM_CHECK_OPTION_GE(klt_levels, 1);
     MBSLAM_CHECK_OPTION(klt_backward_levels >= 1 && klt_backward_levels <= klt_levels);
+    MBSLAM_CHECK_OPTION_GE(klt_fast_flow_px, 0.0);
+    MBSLAM_CHECK_OPTION_GE(klt_fast_window_px, klt_window_px);
+    MBSLAM_CHECK_OPTION_GE(klt_fast_levels, klt_levels);
     MBSLAM_CHECK_OPTION_GT(klt_max_iterations, 0);
     MBSLAM_CHECK_OPTION(klt_threads >= 1 && klt_threads <= 16);
     MBSLAM_CHECK_OPTION_GT(klt_epsilon, 0.0);
@@ -102,6 +111,9 @@ struct TrackerOptions {
     v("klt_levels", &klt_levels, "KLT pyramid levels (count)");
     v("klt_threads", &klt_threads, "KLT points split over this many threads, identical result (count)");
     v("klt_backward_levels", &klt_backward_levels, "levels of the backward consistency pass, which starts at the answer (count)");
+    v("klt_fast_flow_px", &klt_fast_flow_px, "median track motion above which KLT uses the fast settings (px; 0 = off)");
+    v("klt_fast_window_px", &klt_fast_window_px, "KLT window under fast motion (px)");
+    v("klt_fast_levels", &klt_fast_levels, "KLT pyramid levels under fast motion (count)");
     v("klt_max_iterations", &klt_max_iterations, "KLT iterations per level (count)");
     v("klt_epsilon", &klt_epsilon, "KLT convergence (px)");
     v("max_forward_backward_px", &max_forward_backward_px, "forward-backward check (px)");
@@ -146,6 +158,8 @@ struct TrackerStats {
   int created = 0;        // new features
   int rejected_unicity = 0;
   int descriptor_matched = 0;  // recovered by the ORB fallback
+  bool fast_motion = false;    // KLT ran with the fast-motion settings
+  double median_flow_px = 0.0; // median motion of the tracks matched in this image (px)
   bool rejected = false;       // the image was a glitch (see glitch_max_survival): nothing changed
   int established = 0;         // tracks of age >= 3 tried in this image
   int established_matched = 0;
@@ -192,7 +206,8 @@ class FeatureTracker {
   int64_t next_id_ = 1;
   int64_t frame_index_ = -1;
   TrackerStats stats_;
-  bool last_rejected_ = false;  // the previous image was rejected as a glitch
+  bool last_rejected_ = false;
+  double last_median_flow_px_ = 0.0;  // of the previous image's matched tracks  // the previous image was rejected as a glitch
 };
 
 }  // namespace mbslam

@@ -167,6 +167,29 @@ TEST(FeatureTracker, GlitchImageIsRejectedAndTracksSurviveIt) {
   EXPECT_FALSE(plain.stats().rejected);
 }
 
+// Fast image motion switches KLT to its wider window and extra level for the next image,
+// and back when the motion slows down.
+TEST(FeatureTracker, FastMotionSwitchesToWiderKlt) {
+  FeatureTracker tracker(TrackerOptions{});
+  const cv::Mat base = Texture(320, 240, 6);
+  tracker.TrackFrame(Pyramid(base), 0, {});
+  tracker.TrackFrame(Pyramid(Shift(base, 14, 0)), 1, {});
+  EXPECT_FALSE(tracker.stats().fast_motion) << "the first motion is not known yet";
+  EXPECT_NEAR(tracker.stats().median_flow_px, 14.0, 0.5);
+  tracker.TrackFrame(Pyramid(Shift(base, 28, 0)), 2, {});
+  EXPECT_TRUE(tracker.stats().fast_motion);
+  tracker.TrackFrame(Pyramid(Shift(base, 29, 0)), 3, {});
+  EXPECT_TRUE(tracker.stats().fast_motion);
+  EXPECT_NEAR(tracker.stats().median_flow_px, 1.0, 0.3);
+  tracker.TrackFrame(Pyramid(Shift(base, 30, 0)), 4, {});
+  EXPECT_FALSE(tracker.stats().fast_motion);
+  TrackerOptions off;
+  off.klt_fast_flow_px = 0.0;
+  FeatureTracker plain(off);
+  for (int f = 0; f < 3; ++f) plain.TrackFrame(Pyramid(Shift(base, 14 * f, 0)), f, {});
+  EXPECT_FALSE(plain.stats().fast_motion);
+}
+
 TEST(FeatureTracker, GuidedMatchRecoversLostTracksNearPrediction) {
   FeatureTracker tracker(TrackerOptions{});
   const cv::Mat base = Texture(640, 480, 5);
