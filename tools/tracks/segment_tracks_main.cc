@@ -79,6 +79,9 @@ int Run(int argc, char** argv) {
   std::set<std::string> exclude = {"dancing"};
   double focal_factor = 1.0;
   SubspaceClusteringOptions sc_options;
+  SegmentationOptions seg_defaults;
+  double mb_evidence = seg_defaults.multibody_evidence;
+  bool keep_objects = seg_defaults.multibody_keep_objects;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--root" && i + 1 < argc) root = argv[++i];
@@ -88,10 +91,13 @@ int Run(int argc, char** argv) {
     else if (a == "--focal-factor" && i + 1 < argc) focal_factor = std::atof(argv[++i]);
     else if (a == "--ssc-alpha" && i + 1 < argc) sc_options.alpha = std::atof(argv[++i]);
     else if (a == "--ssc-projection" && i + 1 < argc) sc_options.projection_dims_per_motion = std::atoi(argv[++i]);
-    else if (a == "--ssc-mass" && i + 1 < argc) sc_options.coefficient_mass = std::atof(argv[++i]);
+    else if (a == "--ssc-mass" && i + 1 < argc) sc_options.coefficient_masses = {std::atof(argv[++i])};
     else if (a == "--method" && i + 1 < argc) sc_options.method = argv[++i];
     else if (a == "--lsr-lambda" && i + 1 < argc) sc_options.lsr_lambda = std::atof(argv[++i]);
     else if (a == "--merge-ratio" && i + 1 < argc) sc_options.merge_ratio = std::atof(argv[++i]);
+    else if (a == "--cut-weight" && i + 1 < argc) sc_options.order_cut_weight = std::atof(argv[++i]);
+    else if (a == "--multibody-evidence" && i + 1 < argc) mb_evidence = std::atof(argv[++i]);
+    else if (a == "--keep-objects" && i + 1 < argc) keep_objects = std::atoi(argv[++i]) != 0;
     else if (a == "--order" && i + 1 < argc) sc_options.order_selection = argv[++i];
     else if (a == "--max-motions" && i + 1 < argc) sc_options.max_motions = std::atoi(argv[++i]);
     else if (a == "--refine" && i + 1 < argc) sc_options.refine_iterations = std::atoi(argv[++i]);
@@ -130,6 +136,9 @@ int Run(int argc, char** argv) {
   // Short near-affine track sequences: the multi-view multibody initialisation applies.
   SegmentationOptions seg_options;
   seg_options.multibody_init = true;
+  seg_options.multibody = sc_options;  // the clustering flags apply to both settings
+  seg_options.multibody_evidence = mb_evidence;
+  seg_options.multibody_keep_objects = keep_objects;
   const bool do_known = mode != "online", do_online = mode != "known_k";
   std::map<std::string, std::vector<double>> known, online;  // "2", "3", "all"
   int online_k_right = 0, sequences = 0;

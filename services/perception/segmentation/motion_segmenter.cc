@@ -221,6 +221,12 @@ void MotionSegmenter::ClusterUnexplained(const SegmenterInput& in, int64_t ref) 
       t.object = 0;
       continue;
     }
+    if (options_.multibody_keep_objects && t.multibody_object > 0 && objects_.count(t.multibody_object)) {
+      // Grouped by the multi-view initialisation: that verdict stands over proximity.
+      t.object = t.multibody_object;
+      objects_[t.object].last_frame = in.frame_index;
+      continue;
+    }
     Eigen::Vector2d uv_ref;
     int64_t span = in.frame_index - ref;
     if (!t.At(ref, nullptr, &uv_ref)) {
@@ -457,9 +463,11 @@ bool MotionSegmenter::MultibodyInitialize(const SegmenterInput& in) {
     if (t->moving && t->p_static >= options_.static_enter) t->moving = false;
     else if (!t->moving && t->p_static < options_.static_leave) t->moving = true;
   };
+  for (auto& [tid, t] : tracks_) t.multibody_object = -1;
   for (auto& [g, members] : groups) {
     if (g == world) {
       for (TrackState* t : members) {
+        t->multibody_object = 0;
         fuse(t, options_.multibody_evidence);
         if (!t->moving) t->object = 0;
       }
@@ -490,6 +498,7 @@ bool MotionSegmenter::MultibodyInitialize(const SegmenterInput& in) {
     obj.last_frame = n;
     for (TrackState* t : members) {
       fuse(t, -options_.multibody_evidence);
+      t->multibody_object = id;
       if (t->moving) t->object = id;
     }
   }

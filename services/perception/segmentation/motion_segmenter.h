@@ -40,7 +40,8 @@ struct SegmentationOptions {
   int multibody_every_frames = 10;  // re-initialisation period (frames); 0 = only once
   int multibody_max_tracks = 250;   // tracks clustered (subsampled beyond; the rest join by residual) (count)
   int multibody_min_tracks = 20;    // fewer complete tracks: no initialisation (count)
-  double multibody_evidence = 3.0;  // log-odds added for / against static by a multibody grouping
+  double multibody_evidence = 10.0; // log-odds added for / against static by a multibody grouping (beyond the clamp: the grouping decides)
+  bool multibody_keep_objects = true;  // moving tracks grouped by the last multibody initialisation keep that object instead of being re-clustered by proximity
   int lag_frames = 3;               // reference image at least this many images back (frames)
   int history_frames = 16;          // per-track history kept; the reference is at most this far back (frames)
   double target_parallax_px = 12.0; // the reference goes back until static tracks moved this much (px)
@@ -105,6 +106,7 @@ struct SegmentationOptions {
     v("multibody_max_tracks", &multibody_max_tracks, "tracks clustered, the rest join by residual (count)");
     v("multibody_min_tracks", &multibody_min_tracks, "complete tracks needed (count)");
     v("multibody_evidence", &multibody_evidence, "log-odds a multibody grouping adds for / against static");
+    v("multibody_keep_objects", &multibody_keep_objects, "moving tracks keep the object of the last multibody grouping");
     v("lag_frames", &lag_frames, "reference image this many images back (frames)");
     v("history_frames", &history_frames, "per-track history; longest reference lag (frames)");
     v("target_parallax_px", &target_parallax_px, "reference goes back until static tracks moved this much (px)");
@@ -198,6 +200,7 @@ class MotionSegmenter {
     double p_static = 0.5;
     bool moving = false;                  // hysteresis state
     int object = 0;                       // > 0: member of that object (or candidate)
+    int multibody_object = -1;            // object of the last multibody grouping (0 world, -1 none)
     int64_t last_frame = 0;
     double epipolar_px = NAN;
     double p_fvb = NAN;

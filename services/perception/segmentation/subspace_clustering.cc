@@ -299,6 +299,93 @@ std::vector<int> MergeGroups(const Eigen::MatrixXd& Y, std::vector<int> labels, 
   return labels;
 }
 
+double TotalSubspaceResidual(const Eigen::MatrixXd& Y, const std::vector<int>& labels, int dimension) {
+  int k = 0;
+  for (int l : labels) k = std::max(k, l + 1);
+  double total = 0.0;
+  for (int g = 0; g < k; ++g) {
+    const auto n = std::count(labels.begin(), labels.end(), g);
+    total += SubspaceResidual(Y, labels, g, dimension) * static_cast<double>(n);
+  }
+  return total;
+}
+
+namespace {
+
+// Spectral clustering of W into k groups, then the K-subspaces refinement unless it
+// moves more than max_refine_moved of the points: then the subspaces are not separable
+// by residual (dependent motions) and the spectral answer is kept.
+std::vector<int> SpectralAndRefine(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& W, int k,
+                                   const SubspaceClusteringOptions& o) {
+  std::vector<int> labels = SpectralClustering(W, k, o.kmeans_restarts, o.seed);
+  if (o.refine_iterations <= 0 || k <= 1) return labels;
+  std::vector<int> refined = RefineBySubspaces(Y, labels, k, o.subspace_dimension, o.refine_iterations);
+  size_t moved = 0;
+  for (size_t i = 0; i < labels.size(); ++i) moved += refined[i] != labels[i];
+  if (static_cast<double>(moved) <= o.max_refine_moved * static_cast<double>(labels.size())) {
+    return refined;
+  }
+  return labels;
+}
+
+}  // namespace
+
+std::vector<int> SegmentByHypotheses(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& C, int k,
+                                     const SubspaceClusteringOptions& o, double* residual) {
+  std::vector<int> best;
+  double best_residual = std::numeric_limits<double>::max();
+  for (double mass : o.coefficient_masses) {
+    std::vector<int> labels = SpectralAndRefine(Y, CoefficientAffinity(C, mass), k, o);
+    const double r = TotalSubspaceResidual(Y, labels, o.selection_dimension);
+    if (r < best_residual) {  // ties keep the earlier (smaller) mass
+      best_residual = r;
+      best = std::move(labels);
+    }
+  }
+  if (residual) *residual = best_residual;
+  return best;
+}
+
+double NormalizedCut(const Eigen::MatrixXd& W, const std::vector<int>& labels) {
+  int k = 0;
+  for (int l : labels) k = std::max(k, l + 1);
+  if (k <= 1) return 0.0;
+  std::vector<double> cut(static_cast<size_t>(k), 0.0), volume(static_cast<size_t>(k), 0.0);
+  for (Eigen::Index j = 0; j < W.cols(); ++j) {
+    const int gj = labels[static_cast<size_t>(j)];
+    for (Eigen::Index i = 0; i < W.rows(); ++i) {
+      volume[static_cast<size_t>(gj)] += W(i, j);
+      if (labels[static_cast<size_t>(i)] != gj) cut[static_cast<size_t>(gj)] += W(i, j);
+    }
+  }
+  double total = 0.0;
+  for (int g = 0; g < k; ++g) {
+    total += volume[static_cast<size_t>(g)] > 0.0 ? cut[static_cast<size_t>(g)] / volume[static_cast<size_t>(g)] : 1.0;
+  }
+  return total;
+}
+
+std::vector<int> SelectGroupCount(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& C,
+                                  const SubspaceClusteringOptions& o, int* groups) {
+  const Eigen::MatrixXd W = CoefficientAffinity(C, o.order_cut_mass);
+  std::vector<int> best(static_cast<size_t>(Y.cols()), 0);
+  const double residual_1 = std::max(TotalSubspaceResidual(Y, best, o.selection_dimension), 1e-12);
+  double best_score = 0.0;  // k = 1: log(1) + 0
+  *groups = 1;
+  const int k_max = std::min<int>(o.max_motions, static_cast<int>(Y.cols()) / (o.subspace_dimension + 2));
+  for (int k = 2; k <= k_max; ++k) {
+    double residual = 0.0;
+    std::vector<int> labels = SegmentByHypotheses(Y, C, k, o, &residual);
+    const double score = std::log(std::max(residual, 1e-12) / residual_1) + o.order_cut_weight * NormalizedCut(W, labels);
+    if (score < best_score) {
+      best_score = score;
+      best = std::move(labels);
+      *groups = k;
+    }
+  }
+  return best;
+}
+
 std::vector<int> ClusterTrajectories(const Eigen::MatrixXd& Y, int k,
                                      const SubspaceClusteringOptions& o, int* k_used) {
   Eigen::MatrixXd data = Y;
@@ -311,18 +398,25 @@ std::vector<int> ClusterTrajectories(const Eigen::MatrixXd& Y, int k,
   }
   const Eigen::MatrixXd C = o.method == "lsr" ? LeastSquaresSelfExpression(data, o.lsr_lambda)
                                               : SparseSelfExpression(data, o);
-  const Eigen::MatrixXd W = CoefficientAffinity(C, o.coefficient_mass);
-  int groups = k > 0 ? k : (o.order_selection == "eigengap" ? EstimateGroupCount(W, o.max_motions) : o.max_motions);
+  if (k > 0) {
+    if (k_used) *k_used = k;
+    return SegmentByHypotheses(Y, C, k, o);
+  }
+  if (o.order_selection == "cut") {
+    int groups = 1;
+    std::vector<int> labels = SelectGroupCount(Y, C, o, &groups);
+    if (k_used) *k_used = groups;
+    return labels;
+  }
+  const Eigen::MatrixXd W = CoefficientAffinity(C, o.order_cut_mass);
+  int groups = o.order_selection == "eigengap" ? EstimateGroupCount(W, o.max_motions) : o.max_motions;
   std::vector<int> labels = SpectralClustering(W, groups, o.kmeans_restarts, o.seed);
-  if (k <= 0 && o.order_selection == "merge") {
+  if (o.order_selection == "merge") {
     labels = RefineBySubspaces(Y, std::move(labels), groups, o.subspace_dimension, o.refine_iterations);
     labels = MergeGroups(Y, std::move(labels), o.subspace_dimension, o.merge_ratio, &groups);
   }
   if (k_used) *k_used = groups;
   if (o.refine_iterations > 0 && groups > 1) {
-    // The refinement corrects points the spectral step put on the wrong side of a
-    // nearby subspace; when it wants to move many points the subspaces are not
-    // separable by residual (dependent motions) and the spectral answer is kept.
     std::vector<int> refined =
         RefineBySubspaces(Y, labels, groups, o.subspace_dimension, o.refine_iterations);
     size_t moved = 0;

@@ -26,7 +26,11 @@ struct SubspaceClusteringOptions {
   double alpha = 800.0;             // data term weight relative to the smallest coherence (SSC's alpha)
   int max_iterations = 300;         // ADMM iterations (count)
   double tolerance = 2e-4;          // ADMM stopping tolerance on the constraints
-  double coefficient_mass = 0.7;    // each column keeps its largest coefficients up to this share of its L1 mass
+  // Affinity hypotheses: each column keeps its largest coefficients up to each of these
+  // shares of its L1 mass; every share gives one segmentation (spectral + refinement) and
+  // the one that the affine camera model explains best is kept.
+  std::vector<double> coefficient_masses = {0.5, 0.6, 0.7, 0.8, 0.9, 1.0};
+  int selection_dimension = 3;      // hypotheses compared by their residual to affine subspaces of this dimension (3 = affine camera)
   int projection_dims_per_motion = 4;  // project the data to this many dims per motion when k is known; 0 = none
   int kmeans_restarts = 20;         // k-means restarts in the spectral embedding (count)
   int max_motions = 5;              // largest number of motions considered when estimating it (count)
@@ -34,7 +38,9 @@ struct SubspaceClusteringOptions {
   int refine_iterations = 20;       // K-subspaces refinement after spectral clustering; 0 = off (count)
   int subspace_dimension = 4;       // dimension of one motion's trajectory subspace in the refinement (3 affine + 1 for perspective)
   double max_refine_moved = 0.25;   // a refinement that moves more than this share of the points is rejected
-  std::string order_selection = "merge";  // unknown k: "merge" (over-segment, merge by residual) or "eigengap"
+  std::string order_selection = "cut";  // unknown k: "cut" (residual vs graph cut, see SelectGroupCount), "merge" (over-segment, merge by residual) or "eigengap"
+  double order_cut_weight = 4.0;    // "cut": weight of the normalised cut against the log residual
+  double order_cut_mass = 0.7;      // "cut": coefficient mass of the affinity whose cut is measured
   double merge_ratio = 2.0;         // merge two groups while one subspace fits them within this factor of two
 
   bool Check() const {
@@ -43,14 +49,18 @@ struct SubspaceClusteringOptions {
     MBSLAM_CHECK_OPTION_GT(alpha, 0.0);
     MBSLAM_CHECK_OPTION_GT(max_iterations, 0);
     MBSLAM_CHECK_OPTION_GT(tolerance, 0.0);
-    MBSLAM_CHECK_OPTION(coefficient_mass > 0.0 && coefficient_mass <= 1.0);
+    MBSLAM_CHECK_OPTION(!coefficient_masses.empty());
+    for (double m : coefficient_masses) MBSLAM_CHECK_OPTION(m > 0.0 && m <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(selection_dimension, 1);
     MBSLAM_CHECK_OPTION_GE(projection_dims_per_motion, 0);
     MBSLAM_CHECK_OPTION_GT(kmeans_restarts, 0);
     MBSLAM_CHECK_OPTION_GE(max_motions, 1);
     MBSLAM_CHECK_OPTION_GE(refine_iterations, 0);
     MBSLAM_CHECK_OPTION_GE(subspace_dimension, 1);
     MBSLAM_CHECK_OPTION(max_refine_moved >= 0.0 && max_refine_moved <= 1.0);
-    MBSLAM_CHECK_OPTION(order_selection == "merge" || order_selection == "eigengap");
+    MBSLAM_CHECK_OPTION(order_selection == "cut" || order_selection == "merge" || order_selection == "eigengap");
+    MBSLAM_CHECK_OPTION_GT(order_cut_weight, 0.0);
+    MBSLAM_CHECK_OPTION(order_cut_mass > 0.0 && order_cut_mass <= 1.0);
     MBSLAM_CHECK_OPTION_GT(merge_ratio, 1.0);
     return true;
   }
@@ -61,7 +71,8 @@ struct SubspaceClusteringOptions {
     v("alpha", &alpha, "SSC data weight relative to the smallest coherence");
     v("max_iterations", &max_iterations, "ADMM iterations (count)");
     v("tolerance", &tolerance, "ADMM stopping tolerance");
-    v("coefficient_mass", &coefficient_mass, "share of each column's L1 mass kept in the affinity");
+    v("coefficient_masses", &coefficient_masses, "shares of each column's L1 mass kept, one affinity hypothesis each");
+    v("selection_dimension", &selection_dimension, "hypotheses compared by residual to affine subspaces of this dimension");
     v("projection_dims_per_motion", &projection_dims_per_motion, "projection dims per motion when k is known (0 = none)");
     v("kmeans_restarts", &kmeans_restarts, "k-means restarts (count)");
     v("max_motions", &max_motions, "largest number of motions considered (count)");
@@ -69,7 +80,9 @@ struct SubspaceClusteringOptions {
     v("refine_iterations", &refine_iterations, "K-subspaces refinement iterations (0 = off)");
     v("subspace_dimension", &subspace_dimension, "subspace dimension per motion in the refinement");
     v("max_refine_moved", &max_refine_moved, "refinements moving more than this share are rejected");
-    v("order_selection", &order_selection, "unknown number of motions: merge | eigengap");
+    v("order_selection", &order_selection, "unknown number of motions: cut | merge | eigengap");
+    v("order_cut_weight", &order_cut_weight, "cut: weight of the normalised cut against the log residual");
+    v("order_cut_mass", &order_cut_mass, "cut: coefficient mass of the affinity whose cut is measured");
     v("merge_ratio", &merge_ratio, "merge groups while one subspace fits them within this factor");
   }
 };
@@ -106,6 +119,30 @@ double SubspaceResidual(const Eigen::MatrixXd& Y, const std::vector<int>& labels
 // union's residual stays within `merge_ratio` of the separate fits.
 std::vector<int> MergeGroups(const Eigen::MatrixXd& Y, std::vector<int> labels, int dimension,
                              double merge_ratio, int* groups);
+
+// Sum over groups of the squared residuals of the trajectories to their group's best
+// affine subspace of the given dimension (groups of at most dimension + 1 points: 0).
+double TotalSubspaceResidual(const Eigen::MatrixXd& Y, const std::vector<int>& labels, int dimension);
+
+// Segmentation into k groups from self-expressive coefficients C of the columns of Y:
+// for every coefficient mass of the options one hypothesis (affinity, spectral
+// clustering, K-subspaces refinement kept unless it moves more than max_refine_moved of
+// the points); the hypothesis with the smallest TotalSubspaceResidual at
+// selection_dimension is returned (its residual in *residual).
+std::vector<int> SegmentByHypotheses(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& C, int k,
+                                     const SubspaceClusteringOptions& options, double* residual = nullptr);
+
+// Sum over groups of cut(group, rest) / volume(group) in the affinity W (0 for one group).
+double NormalizedCut(const Eigen::MatrixXd& W, const std::vector<int>& labels);
+
+// Model order by a penalised criterion: for every k in [1, max_motions] the
+// SegmentByHypotheses segmentation; k minimises
+//   log(residual_k / residual_1) + order_cut_weight * NormalizedCut(W, labels_k),
+// the affine model's fit (which always improves with more groups) against the
+// self-expressive evidence the groups cut (which grows when a motion is split).
+// Returns the labels, the number of groups in *groups.
+std::vector<int> SelectGroupCount(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& C,
+                                  const SubspaceClusteringOptions& options, int* groups);
 
 // The whole method on trajectories Y (2F x N). k <= 0: estimate the number of motions.
 std::vector<int> ClusterTrajectories(const Eigen::MatrixXd& Y, int k,
