@@ -611,22 +611,27 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
 
   // Each moving object with enough tracks gets its own SLAM (sec. 4.1): the camera w.r.t.
   // the object and the object's points, in its own scale.
+  // Each segmented object's tracks seen in this image (ids, normalised bearings).
+  std::unordered_map<int64_t, Eigen::Vector2d> xy_of;
+  for (const SlamObservation& so : slam_frame.observations) xy_of[so.track_id] = so.xy;
+  std::vector<ObjectTracksInput> object_tracks;
+  for (const SegmentedObject& o : seg.objects) {
+    ObjectTracksInput in;
+    in.id = o.id;
+    for (int64_t id : o.track_ids) {
+      auto it = xy_of.find(id);
+      if (it == xy_of.end()) continue;
+      in.track_ids.push_back(id);
+      in.xy.push_back(it->second);
+    }
+    object_tracks.push_back(std::move(in));
+  }
   std::map<int, ObjectReconstructionResult> reconstruction_of;  // by segment id
   if (options_.object_slam.enabled) {
     ScopedStageTimer timer(object_slam_timer_);
-    std::unordered_map<int64_t, Eigen::Vector2d> xy_of;
-    for (const SlamObservation& so : slam_frame.observations) xy_of[so.track_id] = so.xy;
     std::vector<ObjectTracksInput> inputs;
-    for (const SegmentedObject& o : seg.objects) {
-      ObjectTracksInput in;
-      in.id = o.id;
-      for (int64_t id : o.track_ids) {
-        auto it = xy_of.find(id);
-        if (it == xy_of.end()) continue;
-        in.track_ids.push_back(id);
-        in.xy.push_back(it->second);
-      }
-      if (!in.track_ids.empty()) inputs.push_back(std::move(in));
+    for (const ObjectTracksInput& in : object_tracks) {
+      if (!in.track_ids.empty()) inputs.push_back(in);
     }
     for (ObjectReconstructionResult& r :
          object_reconstruction_->Update(frame_index_, frame.utime, 0.5 * (intrinsics.fx + intrinsics.fy), inputs)) {
@@ -649,17 +654,12 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     of.metric = slam_.metric();
     of.ground = ground_;
     of.rescaled_by = map_update.rescaled_by;
-    std::unordered_map<int64_t, Eigen::Vector2d> xy_of;
-    for (const SlamObservation& so : slam_frame.observations) xy_of[so.track_id] = so.xy;
-    for (const SegmentedObject& o : seg.objects) {
+    for (size_t k = 0; k < seg.objects.size(); ++k) {
+      const SegmentedObject& o = seg.objects[k];
       ObjectObservation ob;
       ob.id = o.id;
-      for (int64_t id : o.track_ids) {
-        auto it = xy_of.find(id);
-        if (it == xy_of.end()) continue;
-        ob.track_ids.push_back(id);
-        ob.track_xy.push_back(it->second);
-      }
+      ob.track_ids = object_tracks[k].track_ids;
+      ob.track_xy = object_tracks[k].xy;
       if (ob.track_xy.empty()) continue;
       Eigen::Vector2d c = Eigen::Vector2d::Zero();
       for (const Eigen::Vector2d& p : ob.track_xy) c += p;

@@ -25,19 +25,26 @@ TEST(ObjectReconstructionTest, ReconstructsAPassingRigidObject) {
   std::vector<Eigen::Vector3d> est_c, true_c;
   std::vector<ObjectReconstructionResult> last;
   int64_t map_id = 0;
-  for (int k = 0; k < 60; ++k) {
-    // cam_from_obj: the object at 10 m, moving right to left, turning 0.5 deg per image.
+  // cam_from_obj in image k: the object at 10 m, moving right to left, turning 0.5 deg
+  // per image; and its tracks in that image.
+  auto cam_from_obj_at = [](int k) {
     const double yaw = 0.5 * M_PI / 180.0 * k;
-    const Rigid3d cam_from_obj(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY())),
-                               Eigen::Vector3d(3.0 - 0.1 * k, 0.5, 10.0));
+    return Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY())),
+                   Eigen::Vector3d(3.0 - 0.1 * k, 0.5, 10.0));
+  };
+  auto tracks_at = [&](int k) {
     ObjectTracksInput in;
     in.id = 7;
     for (size_t i = 0; i < points_obj.size(); ++i) {
-      const Eigen::Vector3d pc = cam_from_obj * points_obj[i];
+      const Eigen::Vector3d pc = cam_from_obj_at(k) * points_obj[i];
       in.track_ids.push_back(static_cast<int64_t>(i));
       in.xy.push_back(pc.head<2>() / pc.z());
     }
-    last = rec.Update(k, 1000000 + k * 33333, focal, {in});
+    return in;
+  };
+  for (int k = 0; k < 60; ++k) {
+    const Rigid3d cam_from_obj = cam_from_obj_at(k);
+    last = rec.Update(k, 1000000 + k * 33333, focal, {tracks_at(k)});
     ASSERT_EQ(last.size(), 1u);
     if (!last[0].valid) continue;
     if (map_id == 0) map_id = last[0].map_id;
@@ -64,17 +71,7 @@ TEST(ObjectReconstructionTest, ReconstructsAPassingRigidObject) {
   // Shape: the last output's points against the truth through the same similarity.
   ObjectReconstructionResult with_points;
   for (int k = 60; k < 80 && !with_points.points_included; ++k) {
-    const double yaw = 0.5 * M_PI / 180.0 * k;
-    const Rigid3d cam_from_obj(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY())),
-                               Eigen::Vector3d(3.0 - 0.1 * k, 0.5, 10.0));
-    ObjectTracksInput in;
-    in.id = 7;
-    for (size_t i = 0; i < points_obj.size(); ++i) {
-      const Eigen::Vector3d pc = cam_from_obj * points_obj[i];
-      in.track_ids.push_back(static_cast<int64_t>(i));
-      in.xy.push_back(pc.head<2>() / pc.z());
-    }
-    with_points = rec.Update(k, 1000000 + k * 33333, focal, {in})[0];
+    with_points = rec.Update(k, 1000000 + k * 33333, focal, {tracks_at(k)})[0];
   }
   ASSERT_TRUE(with_points.points_included);
   ASSERT_GE(with_points.points.size(), 50u);
