@@ -8,7 +8,7 @@ seq=$(sim_sequence robot_odometry "$frames")
 t=$(sed -n 's/^translation: *\[\([^]]*\)\].*/\1/p' "$seq/extrinsic.yaml" | tr -d ' ')
 q=$(sed -n 's/^quaternion: *\[\([^]]*\)\].*/\1/p' "$seq/extrinsic.yaml" | tr -d ' ')
 run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/run" \
-  --set "odometry.base_from_cam_translation=[$t]" --set "odometry.base_from_cam_rotation=[$q]"
+  --set "odometry.base_from_cam_translation=[$t]" --set "odometry.base_from_cam_rotation=[$q]" ${SERVICE_ARGS:-}
 ate=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/run/result/camera_trajectory.tum" \
       --gt-sequence "$seq" --plot "$MBSLAM_EVAL_OUT/trajectory.png")
 ate_se3=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/run/result/camera_trajectory.tum" \
