@@ -128,6 +128,10 @@ std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput&
 void MotionSegmenter::UpdateStaticProbabilities(const SegmenterInput& in, int64_t ref,
                                                 const RelativeMotion& motion) {
   const std::vector<MotionSample> samples = MotionSigmaPoints(motion);
+  StaticLikelihoodOptions likelihood = options_.likelihood;
+  if (likelihood.envelope_combine == "max_odometry") {
+    likelihood.envelope_combine = motion.source == RelativeMotion::Source::kOdometry ? "max" : "mean";
+  }
   for (const TrackObservation& o : in.observations) {
     TrackState& t = tracks_.at(o.id);
     Eigen::Vector2d x_r;
@@ -135,7 +139,7 @@ void MotionSegmenter::UpdateStaticProbabilities(const SegmenterInput& in, int64_
     const DepthBound depth = in.depth_bound ? in.depth_bound(o.id, x_r, ref) : DepthBound();
     const StaticLikelihood lik =
         ComputeStaticLikelihood(x_r, o.xy, samples, motion.translation_known, motion.scale_known,
-                                depth, in.focal_px, options_.likelihood);
+                                depth, in.focal_px, likelihood);
     t.p_static = BayesUpdate(t.p_static, lik.p_static, lik.parallax_px);
     t.epipolar_px = lik.epipolar_px;
     t.p_fvb = lik.p_fvb;

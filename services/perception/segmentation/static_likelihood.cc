@@ -78,7 +78,8 @@ StaticLikelihood ComputeStaticLikelihood(const Eigen::Vector2d& x_r, const Eigen
   if (samples.empty()) return out;
   const double sigma = o.sigma_px / focal_px;
   const size_t count = o.use_envelope ? samples.size() : 1;
-  double weight_sum = 0.0, p = 0.0;
+  const bool use_max = o.envelope_combine == "max";
+  double weight_sum = 0.0, p = 0.0, p_max = 0.0;
   for (size_t j = 0; j < count; ++j) {
     const MotionSample& m = samples[j];
     const double w = o.use_envelope ? m.weight : 1.0;
@@ -91,6 +92,7 @@ StaticLikelihood ComputeStaticLikelihood(const Eigen::Vector2d& x_r, const Eigen
     const double alpha = o.alpha_min + (1.0 - o.alpha_min) * pass;
     const double p_j = o.use_fvb ? alpha * p_ep + (1.0 - alpha) * terms.p_fvb : p_ep;
     p += w * p_j;
+    p_max = std::max(p_max, p_j);
     weight_sum += w;
     if (j == 0) {
       out.epipolar_px = terms.d_epi * focal_px;
@@ -100,7 +102,8 @@ StaticLikelihood ComputeStaticLikelihood(const Eigen::Vector2d& x_r, const Eigen
       out.parallax_px = terms.parallax * focal_px;
     }
   }
-  out.p_static = weight_sum > 0.0 ? std::clamp(p / weight_sum, 0.0, 1.0) : 0.5;
+  if (use_max) out.p_static = std::clamp(p_max, 0.0, 1.0);
+  else out.p_static = weight_sum > 0.0 ? std::clamp(p / weight_sum, 0.0, 1.0) : 0.5;
   return out;
 }
 

@@ -7,6 +7,7 @@
 // Bound constraint through alpha from a chi-square test on the epipolar residual.
 
 #include <limits>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -25,6 +26,11 @@ struct StaticLikelihoodOptions {
   double chi2_softness = 1.0;  // width of the transition of alpha around the threshold
   bool use_fvb = true;         // false: epipolar constraint alone (ablation)
   bool use_envelope = true;    // false: only the mean motion (no pose uncertainty)
+  // How the envelope's motions combine: "mean" (weighted average of their likelihoods),
+  // "max" (a track is as static as the motion in the envelope that explains it best), or
+  // "max_odometry": max for ego-motion from wheel odometry, whose envelope stands for
+  // errors it cannot model (a planar odometry misses roll and pitch), mean otherwise.
+  std::string envelope_combine = "max_odometry";
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(sigma_px, 0.0);
@@ -33,6 +39,7 @@ struct StaticLikelihoodOptions {
     MBSLAM_CHECK_OPTION(alpha_min >= 0.0 && alpha_min <= 1.0);
     MBSLAM_CHECK_OPTION_GT(chi2_threshold, 0.0);
     MBSLAM_CHECK_OPTION_GT(chi2_softness, 0.0);
+    MBSLAM_CHECK_OPTION(envelope_combine == "mean" || envelope_combine == "max" || envelope_combine == "max_odometry");
     return true;
   }
   template <typename V>
@@ -45,6 +52,7 @@ struct StaticLikelihoodOptions {
     v("chi2_softness", &chi2_softness, "width of alpha's transition around the threshold");
     v("use_fvb", &use_fvb, "use the Flow Vector Bound constraint (false = epipolar only)");
     v("use_envelope", &use_envelope, "sample the pose uncertainty (false = mean motion only)");
+    v("envelope_combine", &envelope_combine, "mean | max | max_odometry (max for wheel-odometry ego-motion, else mean): how the envelope's motions combine");
   }
 };
 
