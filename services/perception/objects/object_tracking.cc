@@ -25,6 +25,15 @@ Eigen::Vector2d Centroid(const std::vector<Eigen::Vector2d>& xy) {
   return xy.empty() ? c : Eigen::Vector2d(c / static_cast<double>(xy.size()));
 }
 
+// Axis-aligned bounds of non-empty bearings.
+void Bounds(const std::vector<Eigen::Vector2d>& xy, Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
+  *lo = *hi = xy.front();
+  for (const Eigen::Vector2d& p : xy) {
+    *lo = lo->cwiseMin(p);
+    *hi = hi->cwiseMax(p);
+  }
+}
+
 }  // namespace
 
 ObjectTracking::ObjectTracking(const ObjectTrackingOptions& options) : options_(options) {
@@ -206,11 +215,8 @@ Eigen::Vector2d ObjectTracking::MoveReference(State* s, const ObjectObservation&
   if (!dx.empty()) {
     ref = s->reference_xy + Eigen::Vector2d(Median(dx), Median(dy));
     ref += options_.reference_centroid_pull * (centroid - ref);
-    Eigen::Vector2d lo = o.track_xy.front(), hi = o.track_xy.front();
-    for (const Eigen::Vector2d& p : o.track_xy) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
+    Eigen::Vector2d lo, hi;
+    Bounds(o.track_xy, &lo, &hi);
     ref = ref.cwiseMax(lo).cwiseMin(hi);
   }
   s->last_xy.clear();
@@ -375,11 +381,8 @@ const std::vector<TrackedObject>& ObjectTracking::Update(const ObjectFrame& fram
         s.reference_in_obj = o.sfm->cam_from_obj.Inverse() * (Eigen::Vector3d(ref.x(), ref.y(), 1.0) * o.sfm->median_depth);
       }
       const Eigen::Vector3d q = o.sfm->cam_from_obj * s.reference_in_obj;
-      Eigen::Vector2d lo = o.track_xy.front(), hi = o.track_xy.front();
-      for (const Eigen::Vector2d& p : o.track_xy) {
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-      }
+      Eigen::Vector2d lo, hi;
+      Bounds(o.track_xy, &lo, &hi);
       const Eigen::Vector2d margin = 0.25 * (hi - lo);
       const Eigen::Vector2d proj = q.z() > 0.0 ? Eigen::Vector2d(q.head<2>() / q.z()) : Eigen::Vector2d(1e9, 1e9);
       if (q.z() > 0.0 && (proj.array() >= (lo - margin).array()).all() && (proj.array() <= (hi + margin).array()).all()) {

@@ -609,9 +609,8 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     t.p_static = static_cast<float>(it->second->p_static);
   }
 
-  // Each moving object with enough tracks gets its own SLAM (sec. 4.1): the camera w.r.t.
-  // the object and the object's points, in its own scale.
-  // Each segmented object's tracks seen in this image (ids, normalised bearings).
+  // Each segmented object's tracks seen in this image (ids, normalised bearings), for the
+  // object reconstructions and the object filters.
   std::unordered_map<int64_t, Eigen::Vector2d> xy_of;
   for (const SlamObservation& so : slam_frame.observations) xy_of[so.track_id] = so.xy;
   std::vector<ObjectTracksInput> object_tracks;
@@ -626,15 +625,13 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     }
     object_tracks.push_back(std::move(in));
   }
+  // Each moving object with enough tracks gets its own SLAM (sec. 4.1): the camera w.r.t.
+  // the object and the object's points, in its own scale.
   std::map<int, ObjectReconstructionResult> reconstruction_of;  // by segment id
   if (options_.object_slam.enabled) {
     ScopedStageTimer timer(object_slam_timer_);
-    std::vector<ObjectTracksInput> inputs;
-    for (const ObjectTracksInput& in : object_tracks) {
-      if (!in.track_ids.empty()) inputs.push_back(in);
-    }
-    for (ObjectReconstructionResult& r :
-         object_reconstruction_->Update(frame_index_, frame.utime, 0.5 * (intrinsics.fx + intrinsics.fy), inputs)) {
+    for (ObjectReconstructionResult& r : object_reconstruction_->Update(
+             frame_index_, frame.utime, 0.5 * (intrinsics.fx + intrinsics.fy), object_tracks)) {
       reconstruction_of[r.id] = std::move(r);
     }
   }

@@ -75,7 +75,7 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
 
   for (const ObjectTracksInput* o : order) {
     auto it = entries_.find(o->id);
-    if (it == entries_.end()) continue;
+    if (it == entries_.end() || o->track_ids.empty()) continue;  // no tracks: not seen
     Entry& e = it->second;
     e.last_seen_frame = frame_index;
     SlamFrame frame;

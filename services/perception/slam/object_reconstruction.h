@@ -70,7 +70,7 @@ struct ObjectReconstructionOptions {
   }
 };
 
-// The tracks of one moving object in one image.
+// The tracks of one moving object in one image (an object without tracks counts as unseen).
 struct ObjectTracksInput {
   int id = 0;                          // the object's id (stable across images)
   std::vector<int64_t> track_ids;

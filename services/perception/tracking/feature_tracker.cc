@@ -93,14 +93,14 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   }
 
   const float border = static_cast<float>(options_.border_px);
-  // Kept to undo this image if it turns out to be a glitch (shallow copies of patches).
-  std::vector<Track> before;
-  if (options_.glitch_max_survival > 0.0 && !last_rejected_) before = tracks_;
+  // Nothing in tracks_ changes until the glitch test below has passed (a glitch image
+  // leaves them as they were).
   std::vector<Track> next_tracks;
   next_tracks.reserve(tracks_.size() + 64);
   std::vector<size_t> klt_index;  // into tracks_
   std::vector<cv::Point2f> prev_pts, next_pts;
   std::vector<std::pair<size_t, Eigen::Vector2f>> reappearing;  // occluded, predicted visible
+  std::vector<std::pair<size_t, Eigen::Vector2f>> still_occluded;  // occluded, predicted behind a hull
 
   // Predictions. Tracks already occluded stay so while their predicted position is
   // inside a hull of another body; outside, they are re-detected on their template.
@@ -112,8 +112,7 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     return false;
   };
   for (size_t i = 0; i < tracks_.size(); ++i) {
-    Track& t = tracks_[i];
-    t.is_new = false;
+    const Track& t = tracks_[i];
     auto it = hints.predicted_uv.find(t.id);
     const Eigen::Vector2f pred =
         it != hints.predicted_uv.end() ? it->second : Eigen::Vector2f(t.uv + t.velocity);
@@ -122,11 +121,7 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     if (t.status == TrackStatus::kOccluded) {
       if (inside_other_hull(t, pred)) {
         if (t.occluded_frames >= options_.max_occluded_frames || !InBorder(pred, image, border)) continue;
-        ++t.occluded_frames;
-        t.prev_uv = t.uv;
-        t.uv = pred;
-        ++stats_.occluded;
-        next_tracks.push_back(std::move(t));
+        still_occluded.emplace_back(i, pred);
       } else {
         reappearing.emplace_back(i, pred);
       }
@@ -202,22 +197,52 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   const float fb2 = static_cast<float>(options_.max_forward_backward_px *
                                        options_.max_forward_backward_px);
   const float a = static_cast<float>(options_.velocity_smoothing);
+  // Which tracks KLT matched (forward-backward, border, appearance).
+  std::vector<uint8_t> matched(prev_pts.size(), 0);
+  std::vector<cv::Mat> patches(prev_pts.size());
+  for (size_t k = 0; k < prev_pts.size(); ++k) {
+    const Track& t = tracks_[klt_index[k]];
+    const Eigen::Vector2f next(next_pts[k].x, next_pts[k].y);
+    const cv::Point2f d = back_pts[k] - prev_pts[k];
+    const bool ok = status[k] && back_status[k] && d.dot(d) <= fb2 && next.allFinite() &&
+                    InBorder(next, image, border);
+    matched[k] = ok && ExtractPatch(image, next, options_.patch_size, &patches[k]) &&
+                 (t.patch.empty() || PatchNcc(patches[k], t.patch) >= options_.min_patch_ncc) &&
+                 (t.anchor.empty() || PatchNcc(patches[k], t.anchor) >= options_.min_anchor_ncc);
+    if (t.age >= 3) {
+      ++stats_.established;
+      stats_.established_matched += matched[k];
+    }
+  }
+
+  // A glitch image: nearly every established track lost at once. Nothing changes; the
+  // last good image stays the reference.
+  if (options_.glitch_max_survival > 0.0 && !last_rejected_ && stats_.established >= options_.glitch_min_tracks &&
+      static_cast<double>(stats_.established_matched) <
+          options_.glitch_max_survival * static_cast<double>(stats_.established)) {
+    const TrackerStats seen = stats_;
+    stats_ = TrackerStats();
+    stats_.rejected = true;
+    stats_.established = seen.established;
+    stats_.established_matched = seen.established_matched;
+    last_rejected_ = true;
+    return;
+  }
+
+  for (Track& t : tracks_) t.is_new = false;
+  for (const auto& [i, pred] : still_occluded) {
+    Track& t = tracks_[i];
+    ++t.occluded_frames;
+    t.prev_uv = t.uv;
+    t.uv = pred;
+    ++stats_.occluded;
+    next_tracks.push_back(std::move(t));
+  }
   for (size_t k = 0; k < prev_pts.size(); ++k) {
     Track& t = tracks_[klt_index[k]];
     const Eigen::Vector2f next(next_pts[k].x, next_pts[k].y);
     const cv::Point2f d = back_pts[k] - prev_pts[k];
-    const float fb = d.dot(d);
-    const bool ok = status[k] && back_status[k] && fb <= fb2 && next.allFinite() &&
-                    InBorder(next, image, border);
-    cv::Mat patch;
-    const bool matched = ok && ExtractPatch(image, next, options_.patch_size, &patch) &&
-                         (t.patch.empty() || PatchNcc(patch, t.patch) >= options_.min_patch_ncc) &&
-                         (t.anchor.empty() || PatchNcc(patch, t.anchor) >= options_.min_anchor_ncc);
-    if (t.age >= 3) {
-      ++stats_.established;
-      stats_.established_matched += matched;
-    }
-    if (!matched) {
+    if (!matched[k]) {
       // A failed match of a static track predicted behind a moving object's hull is an
       // occlusion (thesis sec. 2.2 c): keep it, unmatched, until it reappears.
       const Eigen::Vector2f& pred = predicted[klt_index[k]];
@@ -239,30 +264,15 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     t.velocity = t.age > 1 ? Eigen::Vector2f(a * flow + (1.0f - a) * t.velocity) : flow;
     t.prev_uv = t.uv;
     t.uv = next;
-    t.match_error = std::sqrt(fb);
+    t.match_error = std::sqrt(d.dot(d));
     ++t.age;
     t.last_seen_frame = frame_index;
     t.occluded_frames = 0;
-    t.patch = patch;
+    t.patch = patches[k];
     ++stats_.tracked;
     next_tracks.push_back(std::move(t));
   }
 
-  // A glitch image: nearly every established track lost at once. Undo, keep the last
-  // good image as the reference.
-  if (options_.glitch_max_survival > 0.0 && !last_rejected_ && stats_.established >= options_.glitch_min_tracks &&
-      static_cast<double>(stats_.established_matched) <
-          options_.glitch_max_survival * static_cast<double>(stats_.established)) {
-    const TrackerStats seen = stats_;
-    tracks_ = std::move(before);
-    recently_lost_.clear();
-    stats_ = TrackerStats();
-    stats_.rejected = true;
-    stats_.established = seen.established;
-    stats_.established_matched = seen.established_matched;
-    last_rejected_ = true;
-    return;
-  }
   last_rejected_ = false;
   {
     std::vector<float> flows;
