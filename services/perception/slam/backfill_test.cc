@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <iterator>
 #include <map>
 #include <random>
 
@@ -80,6 +82,49 @@ TEST(SlamBackfill, EarlierImagesGetTheirPosesWhenTheMapIsConfirmed) {
     const Eigen::Vector3d c = T.Inverse().translation / scale;
     EXPECT_NEAR((c - Scene::Center(static_cast<int>(f))).norm(), 0.0, 0.01) << "image " << f;
   }
+}
+
+// The image at which the map was initialised (its second keyframe), or -1; tracks with
+// an id of `keep_below` or more end after image `drop_after`.
+int InitImage(const Scene& scene, const SlamOptions& options, int drop_after = 1000, int64_t keep_below = 1000) {
+  SlamSystem slam(options);
+  for (int f = 0; f < 40; ++f) {
+    SlamFrame frame = scene.Frame(f);
+    if (f > drop_after) {
+      auto& obs = frame.observations;
+      obs.erase(std::remove_if(obs.begin(), obs.end(), [&](const SlamObservation& o) { return o.track_id >= keep_below; }),
+                obs.end());
+    }
+    slam.TrackPose(frame);
+    if (slam.map().num_keyframes() >= 2) return static_cast<int>(std::next(slam.map().keyframes().begin())->second.frame_index);
+    std::unordered_map<int64_t, int> labels;
+    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
+    slam.UpdateMap(frame, labels);
+  }
+  return -1;
+}
+
+// An acceptable initialisation from a short baseline waits for more parallax while its
+// tracks last (SlamOptions::init_good_parallax_deg, init_wait_frames, init_wait_keep_ratio).
+TEST(SlamBackfill, ShortBaselineInitialisationWaitsForParallax) {
+  const Scene scene(5);
+  SlamOptions options;
+  options.background_ba = false;
+  options.init_good_parallax_deg = 0.0;
+  const int at_once = InitImage(scene, options);
+  ASSERT_GT(at_once, 0);
+  options.init_good_parallax_deg = 3.0;
+  options.init_wait_frames = 30;
+  const int waited = InitImage(scene, options);
+  EXPECT_GT(waited, at_once + 2);
+  EXPECT_LE(waited, at_once + 30);
+  // The wait is bounded by init_wait_frames.
+  options.init_good_parallax_deg = 45.0;
+  options.init_wait_frames = 5;
+  EXPECT_EQ(InitImage(scene, options), at_once + 5);
+  // When a third of the tracks end just after the first acceptable pair, it goes ahead.
+  options.init_wait_frames = 30;
+  EXPECT_EQ(InitImage(scene, options, at_once, 200), at_once + 1);
 }
 
 TEST(SlamBackfill, OffKeepsOnlyLivePoses) {

@@ -151,6 +151,7 @@ TEST(InitSelection, SlamInitialisesOnTheBackground) {
   const TwoMotionScene s = MakeScene(150, 260, 5);
   SlamOptions options;
   options.background_ba = false;
+  options.init_good_parallax_deg = 0.0;  // two images: no waiting for more parallax
   const std::set<int64_t> tracks = MapTracksAfterInit(options, s);
   ASSERT_GE(tracks.size(), 50u);
   int on_background = 0;
@@ -164,6 +165,7 @@ TEST(InitSelection, ParallaxOnlyOnAFollowedObjectIsRefused) {
   const TwoMotionScene s = MakeScene(150, 260, 6, /*followed=*/true);
   SlamOptions options;
   options.background_ba = false;
+  options.init_good_parallax_deg = 0.0;  // two images: no waiting for more parallax
   EXPECT_TRUE(MapTracksAfterInit(options, s).empty());
   // Without the coverage rule the map is built, on the object.
   options.init_min_coverage = 0.0;

@@ -22,6 +22,9 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   s.init_max_motions = 1;
   s.init_min_coverage = 0.0;
   s.init_max_hull_share = 1.0;
+  // An object is seen briefly and its poses are not back-filled: it starts as soon as
+  // its initialisation is acceptable, without waiting for more parallax.
+  s.init_good_parallax_deg = 0.0;
   // No odometry (it moves the camera, not the object), no images (guided matching), no
   // back-filled poses, no map files.
   s.use_odometry = false;

@@ -68,6 +68,7 @@ void SlamSystem::Reset() {
   map_.Clear();
   state_ = SlamState::kNotInitialized;
   init_ref_frame_ = -1;
+  init_pending_frame_ = -1;
   init_ref_xy_.clear();
   init_ref_odom_.reset();
   recent_poses_.clear();
@@ -369,10 +370,12 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   auto set_reference = [&]() {
     if (static_cast<int>(current.size()) < options_.init_min_tracks) {
       init_ref_frame_ = -1;
+      init_pending_frame_ = -1;
       state_ = SlamState::kNotInitialized;
       return;
     }
     init_ref_frame_ = frame.frame_index;
+    init_pending_frame_ = -1;
     init_ref_xy_ = current;
     init_ref_odom_ = frame.odom_from_cam;
     state_ = SlamState::kInitializing;
@@ -560,6 +563,22 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
       MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": the " << best->points.size()
                         << " points with parallax cover " << map_coverage << " of the image, "
                         << mapped[0].hull_share << " inside moving hulls";
+      return;
+    }
+  }
+
+  // Acceptable, but from a short baseline: wait for more parallax while the tracks last.
+  if (options_.init_good_parallax_deg > 0.0 && best->median_parallax < options_.init_good_parallax_deg * kDeg) {
+    const int shared = static_cast<int>(n);
+    if (init_pending_frame_ < 0) {
+      init_pending_frame_ = frame.frame_index;
+      init_pending_tracks_ = shared;
+    }
+    if (frame.frame_index - init_pending_frame_ < options_.init_wait_frames &&
+        shared >= options_.init_wait_keep_ratio * init_pending_tracks_) {
+      MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << " deferred: median parallax "
+                        << best->median_parallax / kDeg << " deg, " << shared << " of " << init_pending_tracks_
+                        << " tracks shared (acceptable since frame " << init_pending_frame_ << ")";
       return;
     }
   }

@@ -56,6 +56,15 @@ struct SlamOptions {
   double init_min_coverage = 0.3;        // the static world's inliers, and its points with parallax, must hold this share of the image's feature cells
   double init_max_hull_share = 0.5;      // an initialisation with more of its inliers inside moving hulls is refused
   int init_confirm_frames = 3;           // frames the new map must track well before it is trusted (frames)
+  // A map from a short baseline has poorly known depths and biases the poses tracked on
+  // it until the next keyframes re-triangulate. An initialisation that passes every test
+  // but has less than init_good_parallax_deg of median parallax waits for more (the
+  // images meanwhile get their poses back-filled once the map exists) for up to
+  // init_wait_frames, and only while init_wait_keep_ratio of its shared tracks survive
+  // (short-lived tracks: no waiting).
+  double init_good_parallax_deg = 3.0;   // median parallax that ends the wait at once (deg; 0 = no waiting)
+  int init_wait_frames = 15;             // the longest wait for it after the first acceptable pair (frames)
+  double init_wait_keep_ratio = 0.8;     // wait only while this share of the first acceptable pair's tracks is still shared
   // Images without a pose (before and during initialisation, while lost) are kept this
   // many at most; when a map is confirmed their poses are recovered against it (the
   // trajectory files include them; the live pose stream cannot) (frames, <= 60; 0 = off).
@@ -99,6 +108,9 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION(init_min_coverage >= 0.0 && init_min_coverage <= 1.0);
     MBSLAM_CHECK_OPTION(init_max_hull_share >= 0.0 && init_max_hull_share <= 1.0);
     MBSLAM_CHECK_OPTION_GE(init_confirm_frames, 0);
+    MBSLAM_CHECK_OPTION_GE(init_good_parallax_deg, 0.0);
+    MBSLAM_CHECK_OPTION_GE(init_wait_frames, 0);
+    MBSLAM_CHECK_OPTION(init_wait_keep_ratio >= 0.0 && init_wait_keep_ratio <= 1.0);
     MBSLAM_CHECK_OPTION(backfill_max_frames >= 0 && backfill_max_frames <= 60);
     MBSLAM_CHECK_OPTION(init_confirm_inlier_ratio > 0.0 && init_confirm_inlier_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GT(triangulation_min_angle_deg, 0.0);
@@ -130,6 +142,11 @@ struct SlamOptions {
     v("init_min_coverage", &init_min_coverage, "image feature cells the static world's inliers and its points with parallax must hold (share)");
     v("init_max_hull_share", &init_max_hull_share, "inliers inside moving hulls above this share: initialisation refused");
     v("init_confirm_frames", &init_confirm_frames, "frames a new map must track well (frames)");
+    v("init_good_parallax_deg", &init_good_parallax_deg,
+      "an acceptable initialisation with less median parallax waits for more (deg; 0 = no waiting)");
+    v("init_wait_frames", &init_wait_frames, "longest wait for more parallax after the first acceptable pair (frames)");
+    v("init_wait_keep_ratio", &init_wait_keep_ratio,
+      "wait only while this share of the first acceptable pair's shared tracks survives");
     v("backfill_max_frames", &backfill_max_frames,
       "images without a pose kept to recover their poses once a map is confirmed, for the trajectory "
       "files (frames, <= 60; 0 = off)");
@@ -283,6 +300,8 @@ class SlamSystem {
 
   // Initialisation reference view.
   int64_t init_ref_frame_ = -1;
+  int64_t init_pending_frame_ = -1;  // first image that would have made an acceptable map with this reference
+  int init_pending_tracks_ = 0;      // tracks it shared with the reference
   std::unordered_map<int64_t, Eigen::Vector2d> init_ref_xy_;
   std::optional<Rigid3d> init_ref_odom_;
   int confirm_count_ = 0;
