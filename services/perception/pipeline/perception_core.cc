@@ -419,6 +419,12 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     hints.occluders = occluders_;
     tracker_.TrackFrame(pyramid_, frame_index_, hints);
   }
+  if (GetLogLevel() <= LogLevel::kDebug) {
+    const TrackerStats& ts = tracker_.stats();
+    MBSLAM_LOG(DEBUG) << "image " << frame.seq << ": KLT tracked " << ts.tracked << ", lost " << ts.lost << ", created "
+                      << ts.created << ", ORB re-found " << ts.descriptor_matched << ", median flow "
+                      << ts.median_flow_px << " px" << (ts.fast_motion ? " (fast-motion KLT)" : "");
+  }
   if (tracker_.stats().rejected) {
     // A glitch image (flash, corrupted or foreign frame): no pose and no change to any
     // state; the next image is tracked from the last good one.
@@ -516,10 +522,13 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     seg = segmenter_.Update(in);
   }
   if (GetLogLevel() <= LogLevel::kDebug) {
-    int moving = 0;
-    for (const TrackLabel& l : seg.labels) moving += l.body_id != 0;
+    int moving = 0, unjudged = 0;
+    for (const TrackLabel& l : seg.labels) {
+      moving += l.evaluated && l.body_id != 0;
+      unjudged += !l.evaluated;
+    }
     MBSLAM_LOG(DEBUG) << "frame " << frame_index_ << ": tracks " << seg.labels.size() << " moving "
-                      << moving << " objects " << seg.objects.size() << " world motion "
+                      << moving << " new " << unjudged << " objects " << seg.objects.size() << " world motion "
                       << (seg.world_motion ? (seg.world_motion->translation_known ? "R,t" : "R only") : "none")
                       << " ref " << seg.world_ref_frame;
   }
