@@ -133,6 +133,11 @@ int Run(int argc, char** argv) {
                     static_cast<long long>(t.frame_seq), static_cast<long long>(f.id), f.u, f.v, f.body_id,
                     body, f.p_static, f.epipolar_px, f.fvb, f.age);
       }
+      if (std::getenv("EVAL_DUMP_TP") && truly_moving && labelled_moving) {
+        std::printf("TP frame %lld id %lld uv %.0f %.0f body %d mask %d p %.3f epi %.2f fvb %.3f age %d\n",
+                    static_cast<long long>(t.frame_seq), static_cast<long long>(f.id), f.u, f.v, f.body_id,
+                    body, f.p_static, f.epipolar_px, f.fvb, f.age);
+      }
       if (std::getenv("EVAL_DUMP_FP") && !truly_moving && labelled_moving) {
         std::printf("FP frame %lld id %lld uv %.0f %.0f body %d mask %d p %.3f epi %.2f fvb %.3f age %d dist %.1f\n",
                     static_cast<long long>(t.frame_seq), static_cast<long long>(f.id), f.u, f.v, f.body_id,

@@ -48,6 +48,15 @@ struct GroundPlaneOptions {
   // this many camera heights (standard deviation of the centres); 0 = never.
   double path_parallel_min_spread = 1.0;
   int64_t seed = 1;                // RANSAC sampling seed (deterministic)
+  // Use of the plane by the perception pipeline.
+  double min_support = 0.3;  // a plane is used only if this share of the map points lies on it [0, 1]
+  // Static points lie on or above the ground, so along a ray below the horizon a static
+  // point is no deeper than where the ray meets the plane (the depth bound of the flow
+  // vector bound, thesis sec. 3.5.2 / 5.1.1), widened by a margin and, near the horizon,
+  // by the plane's assumed tilt error.
+  double depth_bound_margin = 0.15;             // relative margin on the ground depth (fraction)
+  double depth_bound_min_elevation_deg = 3.0;   // rays closer to the horizon get no ground bound (deg)
+  double depth_bound_tilt_sigma_deg = 2.0;      // assumed tilt error of the plane (deg)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(max_iterations, 0);
@@ -57,6 +66,10 @@ struct GroundPlaneOptions {
     MBSLAM_CHECK_OPTION(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GE(refine_iterations, 0);
     MBSLAM_CHECK_OPTION_GE(path_parallel_min_spread, 0.0);
+    MBSLAM_CHECK_OPTION(min_support >= 0.0 && min_support <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(depth_bound_margin, 0.0);
+    MBSLAM_CHECK_OPTION(depth_bound_min_elevation_deg > 0.0 && depth_bound_min_elevation_deg < 90.0);
+    MBSLAM_CHECK_OPTION_GE(depth_bound_tilt_sigma_deg, 0.0);
     return true;
   }
   template <typename V>
@@ -70,6 +83,13 @@ struct GroundPlaneOptions {
     v("path_parallel_min_spread", &path_parallel_min_spread,
       "camera at a known height: normal perpendicular to keyframe spreads of at least this many camera heights; 0 never");
     v("seed", &seed, "RANSAC sampling seed");
+    v("min_support", &min_support, "a plane is used only if this share of the map points lies on it [0, 1]");
+    v("depth_bound_margin", &depth_bound_margin,
+      "static points lie above the ground: depth bound along rays below the horizon, relative margin (fraction)");
+    v("depth_bound_min_elevation_deg", &depth_bound_min_elevation_deg,
+      "rays closer to the horizon get no ground depth bound (deg)");
+    v("depth_bound_tilt_sigma_deg", &depth_bound_tilt_sigma_deg,
+      "assumed tilt error of the plane, widening the ground depth bound near the horizon (deg)");
   }
 };
 

@@ -173,7 +173,7 @@ void PerceptionCore::UpdateGroundPlane() {
   const Eigen::Vector3d up = -(first.RotationMatrix().transpose() * Eigen::Vector3d::UnitY());
   GroundPlaneEstimate estimate;
   if (!EstimateGroundPlane(points, up, options_.ground, &estimate).ok() ||
-      estimate.inlier_ratio < options_.ground_min_support) {
+      estimate.inlier_ratio < options_.ground.min_support) {
     return;
   }
   const Eigen::Vector3d camera = map.LastKeyframe()->cam_from_world.Inverse().translation;
@@ -190,7 +190,7 @@ void PerceptionCore::UpdateGroundPlane() {
     GroundPlaneEstimate constrained;
     if (h > 0.0 && !directions.empty() &&
         EstimateGroundPlane(points, up, options_.ground, directions, &constrained).ok() &&
-        constrained.inlier_ratio >= options_.ground_min_support) {
+        constrained.inlier_ratio >= options_.ground.min_support) {
       estimate = constrained;
       along_path = true;
     }
@@ -216,12 +216,12 @@ DepthBound PerceptionCore::DepthBoundFor(int64_t track_id, const Eigen::Vector2d
   // Elevation of the ray below the horizon: near the horizon a small error of the
   // plane's tilt moves the intersection far, so the margin grows as the angle shrinks.
   const double elevation = std::asin(std::clamp(-nd / d.norm(), -1.0, 1.0));
-  const double min_elevation = options_.ground_min_elevation_deg * M_PI / 180.0;
+  const double min_elevation = options_.ground.depth_bound_min_elevation_deg * M_PI / 180.0;
   if (elevation < min_elevation) return bound;
   const double z_ground = -ground_->Height(c) / nd;
   if (z_ground <= 0.0) return bound;
-  const double tilt = options_.ground_tilt_sigma_deg * M_PI / 180.0;
-  const double cap = z_ground * (1.0 + options_.ground_depth_margin + tilt / std::tan(elevation));
+  const double tilt = options_.ground.depth_bound_tilt_sigma_deg * M_PI / 180.0;
+  const double cap = z_ground * (1.0 + options_.ground.depth_bound_margin + tilt / std::tan(elevation));
   bound.z_max = std::min(bound.z_max, cap);
   if (bound.z_min > bound.z_max) bound.z_min = 0.0;  // the map point itself is below ground: not trusted
   return bound;

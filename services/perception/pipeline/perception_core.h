@@ -114,10 +114,6 @@ struct CoreOptions {
   // (lockstep: the same result every run) or, live, taking them when done and launching
   // no new ones meanwhile (the niced job never stalls an image).
   bool wait_for_person_checks = true;
-  double ground_depth_margin = 0.15;  // depth bound from the ground: static points lie above it (fraction)
-  double ground_min_elevation_deg = 3.0;  // rays closer to the horizon get no ground bound (deg)
-  double ground_tilt_sigma_deg = 2.0;     // assumed error of the plane's tilt, widening the bound near the horizon (deg)
-  double ground_min_support = 0.3;        // a plane is used only if this share of the map points lies on it
 };
 
 class PerceptionCore : public FrameProcessor {
