@@ -544,6 +544,17 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
       }
       if (any_young) {
         if (std::optional<RelativeMotion> m1 = WorldMotion(in, prev)) {
+          if (options_.young_heading_from_reference && !m1->translation_known && motion &&
+              motion->translation_known && motion->cam_n_from_cam_r.translation.norm() > 1e-12) {
+            // Unit translation along the reference motion's direction (expressed in the
+            // current camera, as the one-image motion's is); its direction uncertainty
+            // is the reference's relative translation uncertainty.
+            const double norm = motion->cam_n_from_cam_r.translation.norm();
+            m1->cam_n_from_cam_r.translation = motion->cam_n_from_cam_r.translation / norm;
+            m1->covariance.topLeftCorner<3, 3>() = motion->covariance.topLeftCorner<3, 3>() / (norm * norm);
+            m1->translation_known = true;
+            m1->scale_known = false;
+          }
           // Only the young tracks: hide the others' reference by evaluating on a filtered set.
           SegmenterInput young = in;
           young.observations.clear();

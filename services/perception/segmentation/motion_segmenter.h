@@ -64,6 +64,13 @@ struct SegmentationOptions {
   int world_min_tracks = 15;        // static tracks needed to estimate the world motion (count)
   double world_min_p_static = 0.25; // tracks at least this likely static take part in the world-motion RANSAC
                                     // (below the moving threshold, so mislabelled static tracks can come back)
+  // Young tracks are judged over one image. A translating camera often moves too little
+  // in one image for its translation to be measured, and the image-to-image motion comes
+  // out as a pure rotation, under which every near static point's parallax is an error.
+  // When the longer reference motion has a known translation, its direction is lent to
+  // the one-image motion (steady heading): young tracks are then judged against the
+  // epipole, with their depth free.
+  bool young_heading_from_reference = true;
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(likelihood);
@@ -128,6 +135,8 @@ struct SegmentationOptions {
     v("min_model_tracks", &min_model_tracks, "tracks for an object's own motion model (count)");
     v("world_min_tracks", &world_min_tracks, "static tracks to estimate the world motion (count)");
     v("world_min_p_static", &world_min_p_static, "P(static) for taking part in the world-motion RANSAC");
+    v("young_heading_from_reference", &young_heading_from_reference,
+      "a pure-rotation image-to-image motion takes the reference motion's translation direction for the young tracks");
   }
 };
 

@@ -188,5 +188,57 @@ TEST(MotionSegmenter, DegenerateFollowingNeedsTheFlowVectorBound) {
   (void)precision_epi;
 }
 
+// A camera creeping forward (1 cm per image, far points): one image is too little to
+// measure its translation, so the image-to-image motion is a pure rotation. Near static
+// points at the sides are re-detected every few images (young tracks judged over one
+// image); their parallax must not make them moving when the longer reference motion
+// knows the heading (SegmentationOptions::young_heading_from_reference).
+TEST(MotionSegmenter, YoungTracksOfACreepingCameraStayStatic) {
+  auto false_moving = [](bool heading_from_reference) {
+    std::mt19937 rng(7);
+    Scene scene = MakeScene(&rng);
+    scene.object_points.clear();
+    scene.world_from_object = [](int) { return Rigid3d(); };
+    scene.world_from_cam = [](int f) { return Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.0, 0.0, 0.01 * f)); };
+    std::vector<Eigen::Vector3d> near;
+    std::uniform_real_distribution<double> side(0.2, 0.35), up(0.15, 0.3), depth(0.8, 1.1);
+    for (int i = 0; i < 40; ++i) near.emplace_back((i % 2 ? 1.0 : -1.0) * side(rng), up(rng), depth(rng));
+    SegmentationOptions options;
+    options.young_heading_from_reference = heading_from_reference;
+    MotionSegmenter seg(options);
+    int judged = 0, moving = 0;
+    std::normal_distribution<double> g(0.0, 0.3 / kFocal);
+    for (int f = 0; f < 48; ++f) {
+      SegmenterInput in = scene.Observe(f, &rng);
+      // The near points are new tracks every 12 images (short-lived tracks), placed anew
+      // ahead of the camera each time.
+      const Rigid3d cam_from_world = scene.world_from_cam(f).Inverse();
+      const Eigen::Vector3d spawned_at = scene.world_from_cam(12 * (f / 12)).translation;
+      for (size_t i = 0; i < near.size(); ++i) {
+        const Eigen::Vector3d pc = cam_from_world * (spawned_at + near[i]);
+        TrackObservation o;
+        o.id = 100000 + 1000 * (f / 12) + static_cast<int64_t>(i);
+        o.xy = pc.hnormalized() + Eigen::Vector2d(g(rng), g(rng));
+        o.uv = Eigen::Vector2d(kFocal * o.xy.x() + 319.5, kFocal * o.xy.y() + 239.5);
+        if (o.uv.x() < 0 || o.uv.y() < 0 || o.uv.x() > kWidth || o.uv.y() > kHeight) continue;
+        in.observations.push_back(o);
+      }
+      const SegmentationResult r = seg.Update(in);
+      if (f < 15) continue;
+      for (const TrackLabel& l : r.labels) {
+        if (l.id < 100000 || !l.evaluated) continue;
+        ++judged;
+        moving += l.body_id != 0;
+      }
+    }
+    EXPECT_GT(judged, 300);
+    return static_cast<double>(moving) / std::max(1, judged);
+  };
+  const double with_heading = false_moving(true);
+  const double rotation_only = false_moving(false);
+  EXPECT_LT(with_heading, 0.05);
+  EXPECT_GT(rotation_only, 0.2) << "the case this guards against no longer arises";
+}
+
 }  // namespace
 }  // namespace mbslam
