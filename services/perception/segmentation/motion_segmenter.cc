@@ -344,15 +344,19 @@ void MotionSegmenter::ClusterUnexplained(const SegmenterInput& in, int64_t ref) 
   }
 }
 
-int64_t MotionSegmenter::ChooseReference(const SegmenterInput& in) const {
-  // The nearest image at least lag_frames back in which the static tracks had moved
-  // target_parallax_px (median image displacement), else the oldest one kept: a longer
-  // baseline makes both constraints, and the flow bound above all, more decisive.
+int64_t MotionSegmenter::EarliestReference(const SegmenterInput& in) const {
   int64_t oldest = in.frame_index;
   for (const TrackObservation& o : in.observations) {
     oldest = std::min(oldest, tracks_.at(o.id).frames.front());
   }
-  const int64_t earliest = std::max(oldest, in.frame_index - options_.history_frames + 1);
+  return std::max(oldest, in.frame_index - options_.history_frames + 1);
+}
+
+int64_t MotionSegmenter::ChooseReference(const SegmenterInput& in) const {
+  // The nearest image at least lag_frames back in which the static tracks had moved
+  // target_parallax_px (median image displacement), else the oldest one kept: a longer
+  // baseline makes both constraints, and the flow bound above all, more decisive.
+  const int64_t earliest = EarliestReference(in);
   int64_t ref = std::max(earliest, in.frame_index - options_.lag_frames);
   for (; ref > earliest; --ref) {
     std::vector<double> disp;
@@ -518,9 +522,24 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
 
   // Reference images: an adaptive lag for established tracks, the previous image for
   // young ones.
-  const int64_t ref = ChooseReference(in);
+  int64_t ref = ChooseReference(in);
   if (ref < in.frame_index) {
     std::optional<RelativeMotion> motion = WorldMotion(in, ref);
+    if (motion && !motion->translation_known && options_.translation_lag_tries > 0) {
+      const int64_t earliest = EarliestReference(in);
+      int64_t lag = in.frame_index - ref;
+      for (int k = 0; k < options_.translation_lag_tries; ++k) {
+        lag *= 2;
+        const int64_t older = std::max(earliest, in.frame_index - lag);
+        if (older >= ref) break;
+        std::optional<RelativeMotion> m = WorldMotion(in, older);
+        if (m && m->translation_known) {
+          ref = older;
+          motion = std::move(m);
+          break;
+        }
+      }
+    }
     if (motion) {
       initialized_ = true;
       UpdateStaticProbabilities(in, ref, *motion);

@@ -71,6 +71,12 @@ struct SegmentationOptions {
   // the one-image motion (steady heading): young tracks are then judged against the
   // epipole, with their depth free.
   bool young_heading_from_reference = true;
+  // The reference image is chosen by image displacement, which a rotating camera has
+  // plenty of before its translation shows: when the two-view motion to it comes out as
+  // a pure rotation, references twice, four times ... as far back (within
+  // history_frames) are tried this many times for one whose translation is measurable
+  // (a pure rotation would make every near static point's parallax look like motion).
+  int translation_lag_tries = 2;
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(likelihood);
@@ -84,6 +90,7 @@ struct SegmentationOptions {
     MBSLAM_CHECK_OPTION_GE(multibody_min_tracks, 8);
     MBSLAM_CHECK_OPTION_GT(multibody_evidence, 0.0);
     MBSLAM_CHECK_OPTION_GE(lag_frames, 1);
+    MBSLAM_CHECK_OPTION(translation_lag_tries >= 0 && translation_lag_tries <= 8);
     MBSLAM_CHECK_OPTION_GT(history_frames, lag_frames);
     MBSLAM_CHECK_OPTION_GT(target_parallax_px, 0.0);
     MBSLAM_CHECK_OPTION(evidence_weight > 0.0 && evidence_weight <= 1.0);
@@ -135,6 +142,8 @@ struct SegmentationOptions {
     v("min_model_tracks", &min_model_tracks, "tracks for an object's own motion model (count)");
     v("world_min_tracks", &world_min_tracks, "static tracks to estimate the world motion (count)");
     v("world_min_p_static", &world_min_p_static, "P(static) for taking part in the world-motion RANSAC");
+    v("translation_lag_tries", &translation_lag_tries,
+      "a pure-rotation reference motion: references 2x, 4x ... as far back tried this often for a measurable translation (count)");
     v("young_heading_from_reference", &young_heading_from_reference,
       "a pure-rotation image-to-image motion takes the reference motion's translation direction for the young tracks");
   }
@@ -238,6 +247,9 @@ class MotionSegmenter {
   // the static world and (re)labels tracks and objects. Returns false if it did not run.
   bool MultibodyInitialize(const SegmenterInput& input);
   int64_t ChooseReference(const SegmenterInput& input) const;
+  // The oldest image a reference can be: the oldest kept by any current track, at most
+  // history_frames back.
+  int64_t EarliestReference(const SegmenterInput& input) const;
 
   const SegmentationOptions options_;
   std::unordered_map<int64_t, TrackState> tracks_;

@@ -240,5 +240,51 @@ TEST(MotionSegmenter, YoungTracksOfACreepingCameraStayStatic) {
   EXPECT_GT(rotation_only, 0.2) << "the case this guards against no longer arises";
 }
 
+// A camera that drives, then creeps forward while panning: the image keeps moving, the
+// translation over the nearest reference with enough displacement no longer shows, and
+// that two-view motion comes out as a pure rotation under which the near static points'
+// parallax looks like motion. Older references are tried for a measurable translation
+// (SegmentationOptions::translation_lag_tries).
+TEST(MotionSegmenter, PanningCreepingCameraLooksFurtherBackForItsTranslation) {
+  auto false_moving = [](int tries) {
+    std::mt19937 rng(8);
+    Scene scene;
+    scene.noise_px = 0.3;
+    scene.world_from_object = [](int) { return Rigid3d(); };
+    scene.world_from_cam = [](int f) {
+      const double z = f < 10 ? 0.03 * f : 0.3 + 0.01 * (f - 10);
+      return Rigid3d(Eigen::Matrix3d(Eigen::AngleAxisd(0.004 * f, Eigen::Vector3d::UnitY())), Eigen::Vector3d(0.0, 0.0, z));
+    };
+    // Far walls (15-30 m) and near ground (2-2.6 m ahead of the start, low in the image).
+    std::uniform_real_distribution<double> fx(-0.6, 0.6), fy(-0.4, 0.2), fz(15.0, 30.0);
+    for (int i = 0; i < 500; ++i) {
+      const double z = fz(rng);
+      scene.static_points.emplace_back(fx(rng) * z, fy(rng) * z, z);
+    }
+    std::uniform_real_distribution<double> side(-0.8, 0.8), up(0.5, 0.7), depth(2.0, 2.6);
+    for (int i = 0; i < 150; ++i) scene.static_points.emplace_back(side(rng), up(rng), depth(rng));
+    SegmentationOptions options;
+    options.translation_lag_tries = tries;
+    MotionSegmenter seg(options);
+    int judged = 0, moving = 0;
+    for (int f = 0; f < 32; ++f) {
+      const SegmenterInput in = scene.Observe(f, &rng);
+      const SegmentationResult r = seg.Update(in);
+      if (f < 15) continue;
+      for (const TrackLabel& l : r.labels) {
+        if (!l.evaluated) continue;
+        ++judged;
+        moving += l.body_id != 0;
+      }
+    }
+    EXPECT_GT(judged, 3000);
+    return static_cast<double>(moving) / std::max(1, judged);
+  };
+  const double further_back = false_moving(2);
+  const double nearest_only = false_moving(0);
+  EXPECT_LT(further_back, 0.02);
+  EXPECT_GT(nearest_only, 0.05) << "the case this guards against no longer arises";
+}
+
 }  // namespace
 }  // namespace mbslam
