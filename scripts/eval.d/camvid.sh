@@ -2,6 +2,7 @@
 # CamVid 0016E5 (101 frames, 15 Hz, car in traffic): share of moving-labelled features on static classes (target <= 5 %) and on cars / people
 #
 #   scripts/eval.sh camvid [--rate HZ] [--calibration YAML] [perception_service args...]
+#   (env SERVICE_ARGS="--set a.b=v ..." passes options to the service too)
 #
 # images/ becomes an LCM log (camera_driver, folder source, 15 Hz nominal stamps), the
 # service replays it lockstep and mbslam-eval-realdata scores PERCEPTION_TRACKS against
@@ -23,6 +24,9 @@ while [[ $# -gt 0 ]]; do
     *) service_args+=("$1"); shift ;;
   esac
 done
+# SERVICE_ARGS="--set a.b=v ..." (as the other evaluations take it) adds to them.
+read -r -a env_args <<< "${SERVICE_ARGS:-}"
+service_args+=(${env_args[@]+"${env_args[@]}"})
 out="$MBSLAM_EVAL_OUT"
 log="$out/camvid.lcmlog"
 "$MBSLAM_BIN/camera_driver" --source folder --input "$root/images" --rate "$rate" \

@@ -2,6 +2,7 @@
 # DAVIS 2016 (10 sequences, real video): moving-feature precision / recall and region IoU (J) per sequence and mean
 #
 #   scripts/eval.sh davis [--rate HZ] [--calibration YAML] [--sequences a,b] [perception_service args...]
+#   (env SERVICE_ARGS="--set a.b=v ..." passes options to the service too)
 #
 # Each sequence's JPEG folder becomes an LCM log (camera_driver, folder source, nominal
 # time stamps at --rate, default 24 Hz: DAVIS 2016 was captured at 24 fps), the service
@@ -27,6 +28,9 @@ while [[ $# -gt 0 ]]; do
     *) service_args+=("$1"); shift ;;
   esac
 done
+# SERVICE_ARGS="--set a.b=v ..." (as the other evaluations take it) adds to them.
+read -r -a env_args <<< "${SERVICE_ARGS:-}"
+service_args+=(${env_args[@]+"${env_args[@]}"})
 out="$MBSLAM_EVAL_OUT"
 mkdir -p "$out/logs" "$out/runs"
 names=()
