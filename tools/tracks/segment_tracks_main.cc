@@ -10,7 +10,9 @@
 // one JSON line.
 //
 //   mbslam-segment-tracks --root DIR [--mode known_k|online|both] [--exclude NAME ...]
-//                         [--only NAME] [--focal-factor F]
+//                         [--only NAME] [--focal-factor F] [--order silhouette|cut|merge|eigengap]
+//                         [--hold 0|1] [--multibody-every FRAMES (5)]
+//                         [--multibody-max-tracks N (400)] [--multibody-max-frames N (30)] ...
 
 #include <algorithm>
 #include <chrono>
@@ -82,6 +84,10 @@ int Run(int argc, char** argv) {
   SegmentationOptions seg_defaults;
   double mb_evidence = seg_defaults.multibody_evidence;
   bool keep_objects = seg_defaults.multibody_keep_objects;
+  bool hold = seg_defaults.multibody_hold;
+  int max_frames = seg_defaults.multibody_max_frames;
+  int max_tracks = 400;  // tracks clustered per initialisation (the service default is 250)
+  int every = 5;  // re-initialise often: the labels reported are those of the last grouping (multibody_hold)
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--root" && i + 1 < argc) root = argv[++i];
@@ -98,7 +104,14 @@ int Run(int argc, char** argv) {
     else if (a == "--cut-weight" && i + 1 < argc) sc_options.order_cut_weight = std::atof(argv[++i]);
     else if (a == "--multibody-evidence" && i + 1 < argc) mb_evidence = std::atof(argv[++i]);
     else if (a == "--keep-objects" && i + 1 < argc) keep_objects = std::atoi(argv[++i]) != 0;
+    else if (a == "--hold" && i + 1 < argc) hold = std::atoi(argv[++i]) != 0;
+    else if (a == "--multibody-every" && i + 1 < argc) every = std::atoi(argv[++i]);
+    else if (a == "--multibody-max-frames" && i + 1 < argc) max_frames = std::atoi(argv[++i]);
+    else if (a == "--multibody-max-tracks" && i + 1 < argc) max_tracks = std::atoi(argv[++i]);
     else if (a == "--order" && i + 1 < argc) sc_options.order_selection = argv[++i];
+    else if (a == "--silhouette-cut" && i + 1 < argc) sc_options.silhouette_cut_weight = std::atof(argv[++i]);
+    else if (a == "--silhouette-residual" && i + 1 < argc) sc_options.silhouette_residual_weight = std::atof(argv[++i]);
+    else if (a == "--min-silhouette" && i + 1 < argc) sc_options.min_silhouette = std::atof(argv[++i]);
     else if (a == "--max-motions" && i + 1 < argc) sc_options.max_motions = std::atoi(argv[++i]);
     else if (a == "--refine" && i + 1 < argc) sc_options.refine_iterations = std::atoi(argv[++i]);
     else if (a == "--subspace-dim" && i + 1 < argc) sc_options.subspace_dimension = std::atoi(argv[++i]);
@@ -139,6 +152,10 @@ int Run(int argc, char** argv) {
   seg_options.multibody = sc_options;  // the clustering flags apply to both settings
   seg_options.multibody_evidence = mb_evidence;
   seg_options.multibody_keep_objects = keep_objects;
+  seg_options.multibody_hold = hold;
+  seg_options.multibody_every_frames = every;
+  seg_options.multibody_max_frames = max_frames;
+  seg_options.multibody_max_tracks = max_tracks;
   const bool do_known = mode != "online", do_online = mode != "known_k";
   std::map<std::string, std::vector<double>> known, online;  // "2", "3", "all"
   int online_k_right = 0, sequences = 0;

@@ -609,7 +609,11 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
     label.epipolar_px = t.epipolar_px;
     label.p_fvb = t.p_fvb;
     label.evaluated = t.frames.size() >= 2;
-    if (!t.moving) {
+    const bool held = options_.multibody_init && options_.multibody_hold && t.multibody_object >= 0 &&
+                      (t.multibody_object == 0 || objects_.count(t.multibody_object));
+    if (held) {
+      label.body_id = t.multibody_object;
+    } else if (!t.moving) {
       label.body_id = label.evaluated ? 0 : -1;
     } else {
       auto it = objects_.find(t.object);

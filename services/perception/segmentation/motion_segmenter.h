@@ -42,6 +42,7 @@ struct SegmentationOptions {
   int multibody_min_tracks = 20;    // fewer complete tracks: no initialisation (count)
   double multibody_evidence = 10.0; // log-odds added for / against static by a multibody grouping (beyond the clamp: the grouping decides)
   bool multibody_keep_objects = true;  // moving tracks grouped by the last multibody initialisation keep that object instead of being re-clustered by proximity
+  bool multibody_hold = true;       // tracks grouped by the last multibody initialisation report that body until the next one (the per-image two-view evidence does not relabel them in between)
   int lag_frames = 3;               // reference image at least this many images back (frames)
   int history_frames = 16;          // per-track history kept; the reference is at most this far back (frames)
   double target_parallax_px = 12.0; // the reference goes back until static tracks moved this much (px)
@@ -121,6 +122,7 @@ struct SegmentationOptions {
     v("multibody_min_tracks", &multibody_min_tracks, "complete tracks needed (count)");
     v("multibody_evidence", &multibody_evidence, "log-odds a multibody grouping adds for / against static");
     v("multibody_keep_objects", &multibody_keep_objects, "moving tracks keep the object of the last multibody grouping");
+    v("multibody_hold", &multibody_hold, "grouped tracks report the body of the last multibody grouping until the next");
     v("lag_frames", &lag_frames, "reference image this many images back (frames)");
     v("history_frames", &history_frames, "per-track history; longest reference lag (frames)");
     v("target_parallax_px", &target_parallax_px, "reference goes back until static tracks moved this much (px)");

@@ -365,23 +365,84 @@ double NormalizedCut(const Eigen::MatrixXd& W, const std::vector<int>& labels) {
   return total;
 }
 
+double SubspaceSilhouette(const Eigen::MatrixXd& Y, const std::vector<int>& labels, int dimension) {
+  int k = 0;
+  for (int l : labels) k = std::max(k, l + 1);
+  if (k <= 1) return 0.0;
+  std::vector<Eigen::VectorXd> means(static_cast<size_t>(k));
+  std::vector<Eigen::MatrixXd> bases(static_cast<size_t>(k));
+  std::vector<bool> valid(static_cast<size_t>(k), false);
+  for (int g = 0; g < k; ++g) {
+    std::vector<Eigen::Index> members;
+    for (Eigen::Index i = 0; i < Y.cols(); ++i) {
+      if (labels[static_cast<size_t>(i)] == g) members.push_back(i);
+    }
+    if (static_cast<int>(members.size()) < dimension + 2) continue;
+    Eigen::MatrixXd M(Y.rows(), static_cast<Eigen::Index>(members.size()));
+    for (size_t m = 0; m < members.size(); ++m) M.col(static_cast<Eigen::Index>(m)) = Y.col(members[m]);
+    means[static_cast<size_t>(g)] = M.rowwise().mean();
+    M.colwise() -= means[static_cast<size_t>(g)];
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
+    bases[static_cast<size_t>(g)] = svd.matrixU().leftCols(std::min<Eigen::Index>(dimension, svd.matrixU().cols()));
+    valid[static_cast<size_t>(g)] = true;
+  }
+  double total = 0.0;
+  int counted = 0;
+  for (Eigen::Index i = 0; i < Y.cols(); ++i) {
+    const int own = labels[static_cast<size_t>(i)];
+    if (!valid[static_cast<size_t>(own)]) continue;
+    auto distance = [&](int g) {
+      const Eigen::VectorXd y = Y.col(i) - means[static_cast<size_t>(g)];
+      const Eigen::MatrixXd& U = bases[static_cast<size_t>(g)];
+      return (y - U * (U.transpose() * y)).norm();
+    };
+    const double a = distance(own);
+    double b = std::numeric_limits<double>::max();
+    for (int g = 0; g < k; ++g) {
+      if (g != own && valid[static_cast<size_t>(g)]) b = std::min(b, distance(g));
+    }
+    if (b == std::numeric_limits<double>::max()) continue;
+    total += (b - a) / std::max({a, b, 1e-12});
+    ++counted;
+  }
+  return counted > 0 ? total / counted : 0.0;
+}
+
 std::vector<int> SelectGroupCount(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& C,
                                   const SubspaceClusteringOptions& o, int* groups) {
   const Eigen::MatrixXd W = CoefficientAffinity(C, o.order_cut_mass);
   std::vector<int> best(static_cast<size_t>(Y.cols()), 0);
   const double residual_1 = std::max(TotalSubspaceResidual(Y, best, o.selection_dimension), 1e-12);
-  double best_score = 0.0;  // k = 1: log(1) + 0
+  const bool silhouette = o.order_selection == "silhouette";
+  double best_score = silhouette ? -std::numeric_limits<double>::max() : 0.0;  // cut, k = 1: log(1) + 0
+  double best_silhouette = 0.0;
   *groups = 1;
   const int k_max = std::min<int>(o.max_motions, static_cast<int>(Y.cols()) / (o.subspace_dimension + 2));
   for (int k = 2; k <= k_max; ++k) {
     double residual = 0.0;
     std::vector<int> labels = SegmentByHypotheses(Y, C, k, o, &residual);
-    const double score = std::log(std::max(residual, 1e-12) / residual_1) + o.order_cut_weight * NormalizedCut(W, labels);
+    const double log_ratio = std::log(std::max(residual, 1e-12) / residual_1);
+    if (silhouette) {
+      const double sil = SubspaceSilhouette(Y, labels, o.selection_dimension);
+      const double score = sil - o.silhouette_cut_weight * NormalizedCut(W, labels) - o.silhouette_residual_weight * log_ratio;
+      if (score > best_score) {
+        best_score = score;
+        best_silhouette = sil;
+        best = std::move(labels);
+        *groups = k;
+      }
+      continue;
+    }
+    const double score = log_ratio + o.order_cut_weight * NormalizedCut(W, labels);
     if (score < best_score) {
       best_score = score;
       best = std::move(labels);
       *groups = k;
     }
+  }
+  if (silhouette && *groups > 1 && best_silhouette < o.min_silhouette) {
+    best.assign(static_cast<size_t>(Y.cols()), 0);
+    *groups = 1;
   }
   return best;
 }
@@ -402,7 +463,7 @@ std::vector<int> ClusterTrajectories(const Eigen::MatrixXd& Y, int k,
     if (k_used) *k_used = k;
     return SegmentByHypotheses(Y, C, k, o);
   }
-  if (o.order_selection == "cut") {
+  if (o.order_selection == "cut" || o.order_selection == "silhouette") {
     int groups = 1;
     std::vector<int> labels = SelectGroupCount(Y, C, o, &groups);
     if (k_used) *k_used = groups;

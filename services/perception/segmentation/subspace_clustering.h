@@ -7,8 +7,9 @@
 // motion, stacked as 2F-vectors, lie in an affine subspace of dimension <= 3, so the
 // motions are found by subspace clustering: sparse self-expression (SSC, Elhamifar &
 // Vidal) solved by ADMM, an affinity from the sparse coefficients, and normalised
-// spectral clustering. The number of motions is given, or estimated from the
-// eigengap of the affinity's normalised Laplacian.
+// spectral clustering. The number of motions is given, or estimated (by default from the
+// subspace silhouette of the segmentations into 2..max_motions groups, see
+// SelectGroupCount).
 
 #include <cstdint>
 #include <string>
@@ -38,10 +39,13 @@ struct SubspaceClusteringOptions {
   int refine_iterations = 20;       // K-subspaces refinement after spectral clustering; 0 = off (count)
   int subspace_dimension = 4;       // dimension of one motion's trajectory subspace in the refinement (3 affine + 1 for perspective)
   double max_refine_moved = 0.25;   // a refinement that moves more than this share of the points is rejected
-  std::string order_selection = "cut";  // unknown k: "cut" (residual vs graph cut, see SelectGroupCount), "merge" (over-segment, merge by residual) or "eigengap"
+  std::string order_selection = "silhouette";  // unknown k: "silhouette" (subspace separation, see SelectGroupCount), "cut" (residual vs graph cut), "merge" (over-segment, merge by residual) or "eigengap"
   double order_cut_weight = 4.0;    // "cut": weight of the normalised cut against the log residual
   double order_cut_mass = 0.7;      // "cut": coefficient mass of the affinity whose cut is measured
   double merge_ratio = 2.0;         // merge two groups while one subspace fits them within this factor of two
+  double silhouette_cut_weight = 0.2;       // "silhouette": weight of the normalised cut subtracted from the silhouette
+  double silhouette_residual_weight = 0.05;  // "silhouette": weight of the log residual ratio (fit) subtracted from it
+  double min_silhouette = 0.4;      // "silhouette": below this subspace silhouette the best split is no split (one motion)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION(method == "ssc" || method == "lsr");
@@ -58,7 +62,11 @@ struct SubspaceClusteringOptions {
     MBSLAM_CHECK_OPTION_GE(refine_iterations, 0);
     MBSLAM_CHECK_OPTION_GE(subspace_dimension, 1);
     MBSLAM_CHECK_OPTION(max_refine_moved >= 0.0 && max_refine_moved <= 1.0);
-    MBSLAM_CHECK_OPTION(order_selection == "cut" || order_selection == "merge" || order_selection == "eigengap");
+    MBSLAM_CHECK_OPTION(order_selection == "silhouette" || order_selection == "cut" || order_selection == "merge" ||
+                        order_selection == "eigengap");
+    MBSLAM_CHECK_OPTION_GE(silhouette_cut_weight, 0.0);
+    MBSLAM_CHECK_OPTION_GE(silhouette_residual_weight, 0.0);
+    MBSLAM_CHECK_OPTION(min_silhouette >= -1.0 && min_silhouette <= 1.0);
     MBSLAM_CHECK_OPTION_GT(order_cut_weight, 0.0);
     MBSLAM_CHECK_OPTION(order_cut_mass > 0.0 && order_cut_mass <= 1.0);
     MBSLAM_CHECK_OPTION_GT(merge_ratio, 1.0);
@@ -80,10 +88,13 @@ struct SubspaceClusteringOptions {
     v("refine_iterations", &refine_iterations, "K-subspaces refinement iterations (0 = off)");
     v("subspace_dimension", &subspace_dimension, "subspace dimension per motion in the refinement");
     v("max_refine_moved", &max_refine_moved, "refinements moving more than this share are rejected");
-    v("order_selection", &order_selection, "unknown number of motions: cut | merge | eigengap");
+    v("order_selection", &order_selection, "unknown number of motions: silhouette | cut | merge | eigengap");
     v("order_cut_weight", &order_cut_weight, "cut: weight of the normalised cut against the log residual");
     v("order_cut_mass", &order_cut_mass, "cut: coefficient mass of the affinity whose cut is measured");
     v("merge_ratio", &merge_ratio, "merge groups while one subspace fits them within this factor");
+    v("silhouette_cut_weight", &silhouette_cut_weight, "silhouette: weight of the normalised cut against the silhouette");
+    v("silhouette_residual_weight", &silhouette_residual_weight, "silhouette: weight of the log residual ratio against the silhouette");
+    v("min_silhouette", &min_silhouette, "silhouette: smallest silhouette of a split into several motions");
   }
 };
 
@@ -135,11 +146,22 @@ std::vector<int> SegmentByHypotheses(const Eigen::MatrixXd& Y, const Eigen::Matr
 // Sum over groups of cut(group, rest) / volume(group) in the affinity W (0 for one group).
 double NormalizedCut(const Eigen::MatrixXd& W, const std::vector<int>& labels);
 
-// Model order by a penalised criterion: for every k in [1, max_motions] the
+// Mean over points of the subspace silhouette (b - a) / max(a, b): a the distance of a
+// point to the affine subspace (of the given dimension) fitted to its own group, b the
+// smallest distance to another group's. Near 1 for well separated subspaces, near 0
+// when one motion is split in two (both halves fit the same subspace). Groups of fewer
+// than dimension + 2 points are skipped; 0 for one group.
+double SubspaceSilhouette(const Eigen::MatrixXd& Y, const std::vector<int>& labels, int dimension);
+
+// Model order (order_selection "cut") by a penalised criterion: for every k in [1, max_motions] the
 // SegmentByHypotheses segmentation; k minimises
 //   log(residual_k / residual_1) + order_cut_weight * NormalizedCut(W, labels_k),
 // the affine model's fit (which always improves with more groups) against the
 // self-expressive evidence the groups cut (which grows when a motion is split).
+// order_selection "silhouette": k in [2, max_motions] maximises
+//   SubspaceSilhouette(labels_k) - silhouette_cut_weight * NormalizedCut(W, labels_k)
+//     - silhouette_residual_weight * log(residual_k / residual_1),
+// and k = 1 when the silhouette of that k is below min_silhouette.
 // Returns the labels, the number of groups in *groups.
 std::vector<int> SelectGroupCount(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& C,
                                   const SubspaceClusteringOptions& options, int* groups);

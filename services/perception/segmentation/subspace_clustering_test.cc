@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <random>
 #include <set>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -77,6 +78,19 @@ TEST(SubspaceClustering, NormalizedCutOfBlockAffinity) {
   EXPECT_GT(NormalizedCut(W, {0, 1, 1, 1}), NormalizedCut(W, {0, 0, 1, 1}));
 }
 
+TEST(SubspaceClustering, SilhouetteSeparatesMotionsFromASplitMotion) {
+  std::vector<int> truth;
+  const Eigen::MatrixXd Y = AffineSubspaces({40, 40}, 24, 0.05, 7, &truth);
+  EXPECT_GT(SubspaceSilhouette(Y, truth, 3), 0.9);
+  // One subspace cut in halves: both halves fit the same subspace.
+  std::vector<int> one;
+  const Eigen::MatrixXd Z = AffineSubspaces({80}, 24, 0.05, 8, &one);
+  std::vector<int> halves(80, 0);
+  for (int i = 40; i < 80; ++i) halves[static_cast<size_t>(i)] = 1;
+  EXPECT_LT(SubspaceSilhouette(Z, halves, 3), 0.3);
+  EXPECT_DOUBLE_EQ(SubspaceSilhouette(Y, std::vector<int>(80, 0), 3), 0.0);
+}
+
 TEST(SubspaceClustering, KnownGroupCountSeparatesSubspaces) {
   std::vector<int> truth;
   const Eigen::MatrixXd Y = AffineSubspaces({40, 30, 25}, 24, 0.05, 2, &truth);
@@ -107,14 +121,17 @@ TEST(SubspaceClustering, HypothesisSelectionKeepsTheBestFittingOne) {
 }
 
 TEST(SubspaceClustering, SelectsTheNumberOfMotions) {
+  for (const std::string order : {"silhouette", "cut"}) {
   SubspaceClusteringOptions o;
+  o.order_selection = order;
   for (const std::vector<int>& sizes : std::vector<std::vector<int>>{{60}, {40, 35}, {40, 30, 30}}) {
     std::vector<int> truth;
     const Eigen::MatrixXd Y = AffineSubspaces(sizes, 24, 0.05, 4, &truth);
     int k = 0;
     const std::vector<int> labels = ClusterTrajectories(Y, 0, o, &k);
-    EXPECT_EQ(k, static_cast<int>(sizes.size()));
-    EXPECT_LE(Errors(truth, labels), 0.05);
+    EXPECT_EQ(k, static_cast<int>(sizes.size())) << order;
+    EXPECT_LE(Errors(truth, labels), 0.05) << order;
+  }
   }
 }
 
