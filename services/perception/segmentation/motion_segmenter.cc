@@ -412,26 +412,12 @@ bool MotionSegmenter::MultibodyInitialize(const SegmenterInput& in) {
 
   // Every complete track joins the group whose subspace explains it best.
   const int dim = options_.multibody.subspace_dimension;
-  std::vector<Eigen::VectorXd> means(static_cast<size_t>(k));
-  std::vector<Eigen::MatrixXd> bases(static_cast<size_t>(k));
-  std::vector<int> sizes(static_cast<size_t>(k), 0);
-  for (int g = 0; g < k; ++g) {
-    std::vector<Eigen::Index> members;
-    for (size_t c = 0; c < sample.size(); ++c) {
-      if (sample_labels[c] == g) members.push_back(static_cast<Eigen::Index>(c));
-    }
-    sizes[static_cast<size_t>(g)] = static_cast<int>(members.size());
-    if (members.empty()) continue;
-    Eigen::MatrixXd M(Y.rows(), static_cast<Eigen::Index>(members.size()));
-    for (size_t m = 0; m < members.size(); ++m) M.col(static_cast<Eigen::Index>(m)) = Y.col(members[m]);
-    means[static_cast<size_t>(g)] = M.rowwise().mean();
-    M.colwise() -= means[static_cast<size_t>(g)];
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
-    bases[static_cast<size_t>(g)] = svd.matrixU().leftCols(std::min<Eigen::Index>(dim, svd.matrixU().cols()));
-  }
+  const std::vector<AffineSubspace> subspaces = FitGroupSubspaces(Y, sample_labels, k, dim, 1);
   // Groups too small to be objects are absorbed by the best-fitting larger group.
   std::vector<bool> usable(static_cast<size_t>(k));
-  for (int g = 0; g < k; ++g) usable[static_cast<size_t>(g)] = sizes[static_cast<size_t>(g)] >= std::max(dim + 2, options_.min_object_tracks);
+  for (int g = 0; g < k; ++g) {
+    usable[static_cast<size_t>(g)] = subspaces[static_cast<size_t>(g)].members >= std::max(dim + 2, options_.min_object_tracks);
+  }
   if (std::none_of(usable.begin(), usable.end(), [](bool u) { return u; })) return false;
   std::map<int, std::vector<TrackState*>> groups;
   for (const TrackState* tc : complete) {
@@ -440,9 +426,7 @@ bool MotionSegmenter::MultibodyInitialize(const SegmenterInput& in) {
     double best_r = std::numeric_limits<double>::max();
     for (int g = 0; g < k; ++g) {
       if (!usable[static_cast<size_t>(g)]) continue;
-      const Eigen::VectorXd d = y - means[static_cast<size_t>(g)];
-      const Eigen::MatrixXd& U = bases[static_cast<size_t>(g)];
-      const double r = (d - U * (U.transpose() * d)).squaredNorm();
+      const double r = subspaces[static_cast<size_t>(g)].SquaredDistance(y);
       if (r < best_r) {
         best_r = r;
         best = g;

@@ -199,38 +199,39 @@ int EstimateGroupCount(const Eigen::MatrixXd& W, int k_max) {
   return best_k;
 }
 
+std::vector<AffineSubspace> FitGroupSubspaces(const Eigen::MatrixXd& Y, const std::vector<int>& labels, int k,
+                                              int dimension, int min_members) {
+  std::vector<AffineSubspace> out(static_cast<size_t>(std::max(k, 0)));
+  for (int g = 0; g < k; ++g) {
+    std::vector<Eigen::Index> members;
+    for (Eigen::Index i = 0; i < Y.cols(); ++i) {
+      if (labels[static_cast<size_t>(i)] == g) members.push_back(i);
+    }
+    AffineSubspace& s = out[static_cast<size_t>(g)];
+    s.members = static_cast<int>(members.size());
+    if (members.empty() || s.members < min_members) continue;
+    Eigen::MatrixXd M(Y.rows(), static_cast<Eigen::Index>(members.size()));
+    for (size_t m = 0; m < members.size(); ++m) M.col(static_cast<Eigen::Index>(m)) = Y.col(members[m]);
+    s.mean = M.rowwise().mean();
+    M.colwise() -= s.mean;
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
+    s.basis = svd.matrixU().leftCols(std::min<Eigen::Index>(dimension, svd.matrixU().cols()));
+  }
+  return out;
+}
+
 std::vector<int> RefineBySubspaces(const Eigen::MatrixXd& Y, std::vector<int> labels, int k,
                                    int dimension, int iterations) {
   const Eigen::Index n = Y.cols();
   for (int iter = 0; iter < iterations; ++iter) {
-    std::vector<Eigen::VectorXd> means(static_cast<size_t>(k));
-    std::vector<Eigen::MatrixXd> bases(static_cast<size_t>(k));
-    std::vector<bool> valid(static_cast<size_t>(k), false);
-    for (int c = 0; c < k; ++c) {
-      std::vector<Eigen::Index> members;
-      for (Eigen::Index i = 0; i < n; ++i) {
-        if (labels[static_cast<size_t>(i)] == c) members.push_back(i);
-      }
-      if (static_cast<int>(members.size()) < dimension + 2) continue;
-      Eigen::MatrixXd M(Y.rows(), static_cast<Eigen::Index>(members.size()));
-      for (size_t m = 0; m < members.size(); ++m) M.col(static_cast<Eigen::Index>(m)) = Y.col(members[m]);
-      const Eigen::VectorXd mean = M.rowwise().mean();
-      M.colwise() -= mean;
-      Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
-      const Eigen::Index d = std::min<Eigen::Index>(dimension, svd.matrixU().cols());
-      means[static_cast<size_t>(c)] = mean;
-      bases[static_cast<size_t>(c)] = svd.matrixU().leftCols(d);
-      valid[static_cast<size_t>(c)] = true;
-    }
+    const std::vector<AffineSubspace> subspaces = FitGroupSubspaces(Y, labels, k, dimension, dimension + 2);
     bool changed = false;
     for (Eigen::Index i = 0; i < n; ++i) {
       int best = labels[static_cast<size_t>(i)];
       double best_r = std::numeric_limits<double>::max();
       for (int c = 0; c < k; ++c) {
-        if (!valid[static_cast<size_t>(c)]) continue;
-        const Eigen::VectorXd y = Y.col(i) - means[static_cast<size_t>(c)];
-        const Eigen::MatrixXd& U = bases[static_cast<size_t>(c)];
-        const double r = (y - U * (U.transpose() * y)).squaredNorm();
+        if (!subspaces[static_cast<size_t>(c)].valid()) continue;
+        const double r = subspaces[static_cast<size_t>(c)].SquaredDistance(Y.col(i));
         if (r < best_r) {
           best_r = r;
           best = c;
@@ -369,37 +370,17 @@ double SubspaceSilhouette(const Eigen::MatrixXd& Y, const std::vector<int>& labe
   int k = 0;
   for (int l : labels) k = std::max(k, l + 1);
   if (k <= 1) return 0.0;
-  std::vector<Eigen::VectorXd> means(static_cast<size_t>(k));
-  std::vector<Eigen::MatrixXd> bases(static_cast<size_t>(k));
-  std::vector<bool> valid(static_cast<size_t>(k), false);
-  for (int g = 0; g < k; ++g) {
-    std::vector<Eigen::Index> members;
-    for (Eigen::Index i = 0; i < Y.cols(); ++i) {
-      if (labels[static_cast<size_t>(i)] == g) members.push_back(i);
-    }
-    if (static_cast<int>(members.size()) < dimension + 2) continue;
-    Eigen::MatrixXd M(Y.rows(), static_cast<Eigen::Index>(members.size()));
-    for (size_t m = 0; m < members.size(); ++m) M.col(static_cast<Eigen::Index>(m)) = Y.col(members[m]);
-    means[static_cast<size_t>(g)] = M.rowwise().mean();
-    M.colwise() -= means[static_cast<size_t>(g)];
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
-    bases[static_cast<size_t>(g)] = svd.matrixU().leftCols(std::min<Eigen::Index>(dimension, svd.matrixU().cols()));
-    valid[static_cast<size_t>(g)] = true;
-  }
+  const std::vector<AffineSubspace> subspaces = FitGroupSubspaces(Y, labels, k, dimension, dimension + 2);
   double total = 0.0;
   int counted = 0;
   for (Eigen::Index i = 0; i < Y.cols(); ++i) {
     const int own = labels[static_cast<size_t>(i)];
-    if (!valid[static_cast<size_t>(own)]) continue;
-    auto distance = [&](int g) {
-      const Eigen::VectorXd y = Y.col(i) - means[static_cast<size_t>(g)];
-      const Eigen::MatrixXd& U = bases[static_cast<size_t>(g)];
-      return (y - U * (U.transpose() * y)).norm();
-    };
+    if (!subspaces[static_cast<size_t>(own)].valid()) continue;
+    auto distance = [&](int g) { return std::sqrt(subspaces[static_cast<size_t>(g)].SquaredDistance(Y.col(i))); };
     const double a = distance(own);
     double b = std::numeric_limits<double>::max();
     for (int g = 0; g < k; ++g) {
-      if (g != own && valid[static_cast<size_t>(g)]) b = std::min(b, distance(g));
+      if (g != own && subspaces[static_cast<size_t>(g)].valid()) b = std::min(b, distance(g));
     }
     if (b == std::numeric_limits<double>::max()) continue;
     total += (b - a) / std::max({a, b, 1e-12});

@@ -116,6 +116,26 @@ std::vector<int> SpectralClustering(const Eigen::MatrixXd& W, int k, int restart
 // Number of groups in [1, k_max] with the largest eigengap of the normalised Laplacian.
 int EstimateGroupCount(const Eigen::MatrixXd& W, int k_max);
 
+// An affine subspace fitted to a group of trajectories: its mean and an orthonormal
+// basis (empty when the group had too few members to fit).
+struct AffineSubspace {
+  Eigen::VectorXd mean;
+  Eigen::MatrixXd basis;
+  int members = 0;  // columns of the group
+  bool valid() const { return basis.size() > 0; }
+  // Squared distance of y to the subspace.
+  double SquaredDistance(const Eigen::VectorXd& y) const {
+    const Eigen::VectorXd d = y - mean;
+    return (d - basis * (basis.transpose() * d)).squaredNorm();
+  }
+};
+
+// For each group g in [0, k): the affine subspace of the given dimension through the
+// columns of Y labelled g (mean, then the leading left singular vectors of the centred
+// columns); groups with fewer than min_members columns are left without one.
+std::vector<AffineSubspace> FitGroupSubspaces(const Eigen::MatrixXd& Y, const std::vector<int>& labels, int k,
+                                              int dimension, int min_members);
+
 // K-subspaces refinement: each point moves to the affine subspace (of the given
 // dimension, fitted to the current groups) that explains it best, until stable.
 std::vector<int> RefineBySubspaces(const Eigen::MatrixXd& Y, std::vector<int> labels, int k,
