@@ -59,16 +59,22 @@ Matrix6d EpipolarCovariance(const Rigid3d& T, const std::vector<Eigen::Vector2d>
                             const std::vector<uint8_t>& inliers, double sigma) {
   Matrix6d info = Matrix6d::Zero();
   constexpr double h = 1e-6;
+  // The perturbed essential matrices do not depend on the point: built once.
+  Eigen::Matrix3d E_plus[6], E_minus[6];
+  for (int k = 0; k < 6; ++k) {
+    Vector6d d = Vector6d::Zero();
+    d[k] = h;
+    const Rigid3d Tp = Rigid3d::Exp(d) * T;
+    const Rigid3d Tm = Rigid3d::Exp(-d) * T;
+    E_plus[k] = Hat(Tp.translation) * Tp.RotationMatrix();
+    E_minus[k] = Hat(Tm.translation) * Tm.RotationMatrix();
+  }
   for (size_t i = 0; i < x_r.size(); ++i) {
     if (!inliers[i]) continue;
     Eigen::Matrix<double, 1, 6> J;
     for (int k = 0; k < 6; ++k) {
-      Vector6d d = Vector6d::Zero();
-      d[k] = h;
-      const Rigid3d Tp = Rigid3d::Exp(d) * T;
-      const Rigid3d Tm = Rigid3d::Exp(-d) * T;
-      const double rp = EpipolarDistance(Hat(Tp.translation) * Tp.RotationMatrix(), x_r[i], x_n[i]);
-      const double rm = EpipolarDistance(Hat(Tm.translation) * Tm.RotationMatrix(), x_r[i], x_n[i]);
+      const double rp = EpipolarDistance(E_plus[k], x_r[i], x_n[i]);
+      const double rm = EpipolarDistance(E_minus[k], x_r[i], x_n[i]);
       J[k] = (rp - rm) / (2.0 * h);
     }
     info += J.transpose() * J;
@@ -146,6 +152,87 @@ Rigid3d RefineMotion(const Rigid3d& initial, const std::vector<Eigen::Vector2d>&
   return T;
 }
 
+// The motion x_n = R x_r + t encoded by an essential matrix, by cv::recoverPose's rule:
+// of the four decompositions, the one that puts the most RANSAC inliers (`mask`) in front
+// of both cameras and closer than 50 baselines. Returns that count.
+// cv::recoverPose triangulates every point for all four candidates (one 4x4 SVD each),
+// which was a fifth of the front end's time. Here a closed-form screen (least-squares
+// depths along the two rays) picks the candidate first; when it clearly dominates, only
+// that candidate is triangulated as cv::recoverPose would, and only on the inliers, so
+// the count and the pose are cv::recoverPose's. Otherwise (near-degenerate geometry, or
+// the screen and the triangulation disagree) cv::recoverPose itself decides.
+int PoseFromEssential(const cv::Mat& E, const std::vector<cv::Point2d>& pr, const std::vector<cv::Point2d>& pn,
+                      const cv::Mat& mask, Eigen::Matrix3d* R, Eigen::Vector3d* t) {
+  constexpr double max_depth = 50.0;  // cv::recoverPose's distance threshold (baselines)
+  cv::Mat R1, R2, tc;
+  cv::decomposeEssentialMat(E, R1, R2, tc);
+  const cv::Mat Rc[4] = {R1, R2, R1, R2};
+  const cv::Mat tcs[4] = {tc, tc, -tc, -tc};
+  const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>();
+  std::vector<cv::Point2d> sr, sn;  // the inliers
+  sr.reserve(pr.size());
+  sn.reserve(pr.size());
+  for (size_t i = 0; i < pr.size(); ++i) {
+    if (m != nullptr && !m[i]) continue;
+    sr.push_back(pr[i]);
+    sn.push_back(pn[i]);
+  }
+  int screen[4] = {0, 0, 0, 0};
+  for (int c = 0; c < 4; ++c) {
+    Eigen::Matrix3d Rm;
+    Eigen::Vector3d tm;
+    cv::cv2eigen(Rc[c], Rm);
+    cv::cv2eigen(tcs[c], tm);
+    for (size_t i = 0; i < sr.size(); ++i) {
+      // Depths z_r, z_n minimising |z_n b - (z_r a + t)|, a = R x_r, b = x_n (homogeneous).
+      const Eigen::Vector3d a = Rm * Eigen::Vector3d(sr[i].x, sr[i].y, 1.0);
+      const Eigen::Vector3d b(sn[i].x, sn[i].y, 1.0);
+      const double aa = a.dot(a), bb = b.dot(b), ab = a.dot(b);
+      const double det = aa * bb - ab * ab;
+      if (det <= 1e-12 * aa * bb) continue;  // parallel rays: a point at infinity
+      const double z_r = (-a.dot(tm) * bb + ab * b.dot(tm)) / det;
+      const double depth_n = (z_r * a + tm).z();
+      if (z_r > 0.0 && z_r < max_depth && depth_n > 0.0 && depth_n < max_depth) ++screen[c];
+    }
+  }
+  int best = 0;
+  for (int c = 1; c < 4; ++c) {
+    if (screen[c] > screen[best]) best = c;
+  }
+  int second = 0;
+  for (int c = 0; c < 4; ++c) {
+    if (c != best) second = std::max(second, screen[c]);
+  }
+  if (screen[best] > 0 && screen[best] >= 2 * second) {
+    // cv::recoverPose's test for one candidate: DLT triangulation, positive and bounded
+    // depth in both cameras.
+    cv::Mat P0 = cv::Mat::eye(3, 4, CV_64F), P1(3, 4, CV_64F), Q;
+    Rc[best].copyTo(P1.colRange(0, 3));
+    tcs[best].copyTo(P1.col(3));
+    cv::triangulatePoints(P0, P1, sr, sn, Q);
+    int good = 0;
+    for (int i = 0; i < Q.cols; ++i) {
+      const double w = Q.at<double>(3, i);
+      if (!(Q.at<double>(2, i) * w > 0.0)) continue;
+      const cv::Vec4d X(Q.at<double>(0, i) / w, Q.at<double>(1, i) / w, Q.at<double>(2, i) / w, w / w);
+      if (!(X[2] < max_depth)) continue;
+      double z_n = 0.0;
+      for (int k = 0; k < 4; ++k) z_n += P1.at<double>(2, k) * X[k];
+      if (z_n > 0.0 && z_n < max_depth) ++good;
+    }
+    if (2 * good >= screen[best]) {
+      cv::cv2eigen(Rc[best], *R);
+      cv::cv2eigen(tcs[best], *t);
+      return good;
+    }
+  }
+  cv::Mat Rr, tr, full_mask = mask.clone();
+  const int good = cv::recoverPose(E, pr, pn, Rr, tr, 1.0, cv::Point2d(0, 0), full_mask);
+  cv::cv2eigen(Rr, *R);
+  cv::cv2eigen(tr, *t);
+  return good;
+}
+
 }  // namespace
 
 Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
@@ -220,13 +307,10 @@ Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
   cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC,
                                    options.ransac_confidence, thresh, options.ransac_max_iterations, mask);
   if (E.empty() || E.rows != 3) return Status::Error("essential matrix RANSAC failed");
-  cv::Mat R, t;
-  const int good = cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask);
-  if (good < options.min_points) return Status::Error("pose recovery found too few points in front");
   Eigen::Matrix3d Re;
   Eigen::Vector3d te;
-  cv::cv2eigen(R, Re);
-  cv::cv2eigen(t, te);
+  const int good = PoseFromEssential(E.rowRange(0, 3), pr, pn, mask, &Re, &te);
+  if (good < options.min_points) return Status::Error("pose recovery found too few points in front");
   Rigid3d T(Re, te.normalized());
   inliers->assign(n, 0);
   for (int round = 0; round < 2; ++round) {
