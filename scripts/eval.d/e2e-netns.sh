@@ -2,6 +2,7 @@
 # End to end through real processes in a private network namespace: lcm-logplayer (real rate) -> perception_service (realtime) -> viewer, outputs recorded by lcm-logger; scored like the stage evaluations
 #
 #   scripts/eval.sh e2e-netns [SCENARIO] [FRAMES]     (default: multi 300)
+#   (env SERVICE_ARGS="--set a.b=v ..." passes options to the service)
 #
 # LCM's udpm:// multicast is used only inside the namespace (test/netns/run_in_netns.sh).
 # The service runs live (drops stale frames and counts them), so its figures depend on
@@ -18,12 +19,12 @@ cam_height=$(awk '!/^#/ && NF >= 8 {s += $4; n++} END {if (n) printf "%.3f", s /
 
 "$MBSLAM_ROOT/test/netns/run_in_netns.sh" bash -c '
   set -u
-  bin="$1"; seq="$2"; live="$3"; root="$4"; cam_height="$5"
+  bin="$1"; seq="$2"; live="$3"; root="$4"; cam_height="$5"; shift 5  # then the service options
   url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"  # 640x480 raw images: the default socket buffer holds less than one
   lcm-logger --lcm-url="$url" --quiet --channel="PERCEPTION_.*" "$live/outputs.lcmlog" 2>"$live/logger.log" &
   logger=$!
   "$bin/perception_service" --lcm-url "$url" --mode realtime --output-dir "$live/result" \
-      --set "objects.camera_height_m=$cam_height" 2>"$live/service.log" &
+      --set "objects.camera_height_m=$cam_height" "$@" 2>"$live/service.log" &
   service=$!
   "$bin/viewer" --config "$root/config/viewer.yaml" --lcm-url "$url" --out "$live/snapshots" \
       --set viewer.log_level=warning --set viewer.snapshot_period_s=2.0 2>"$live/viewer.log" &
@@ -37,7 +38,7 @@ cam_height=$(awk '!/^#/ && NF >= 8 {s += $4; n++} END {if (n) printf "%.3f", s /
   kill -INT "$logger"; wait "$logger" || true
   echo "service exit $s, viewer exit $v" >&2
   [[ $s -eq 0 && $v -eq 0 ]]
-' _ "$MBSLAM_BIN" "$seq" "$out/live" "$MBSLAM_ROOT" "$cam_height"
+' _ "$MBSLAM_BIN" "$seq" "$out/live" "$MBSLAM_ROOT" "$cam_height" ${SERVICE_ARGS:-}
 
 ate=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$out/live/result/camera_trajectory.tum" --gt-sequence "$seq")
 seg=$(last_json "$MBSLAM_BIN/mbslam-eval-segmentation" --run "$out/live/outputs.lcmlog" --sequence "$seq" --name "$scenario")

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Soak: looped live replay for N minutes (default 20), RSS trend beyond the map's own memory; --asan: LeakSanitizer build
 # Usage: scripts/eval.sh soak [MINUTES] [--asan] [--default-config] [--scenario NAME] [--set a.b=v ...]
+#   (env SERVICE_ARGS="--set a.b=v ..." passes options to the service too)
 # By default the map is held small (slam.max_keyframes=40, occupancy off) as in the
 # slow soak test, so that a trend is a leak; --default-config runs the service's defaults
 # (200 keyframes, local BA, occupancy: map growth shows in map_* and map_bounded).
@@ -18,6 +19,9 @@ main() {  # read in full before it runs: editing the file during a run changes n
 minutes=20
 asan=0
 extra=()
+# Service options from the environment, as the other evaluations take them.
+read -r -a service_env <<<"${SERVICE_ARGS:-}"
+extra+=("${service_env[@]}")
 bounded=(--set slam.max_keyframes=40 --set occupancy_enabled=false)
 scenario=crossing
 while [[ $# -gt 0 ]]; do

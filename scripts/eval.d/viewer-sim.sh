@@ -2,6 +2,7 @@
 # viewer: snapshots of the whole pipeline's outputs on a simulated scenario (lockstep service run + camera images), 3D follow / top-down and image views
 #
 # Usage: scripts/eval.sh viewer-sim [SCENARIO [FRAMES]]   (default: multi, 300 frames)
+#   (env SERVICE_ARGS="--set a.b=v ..." passes options to the service)
 # Runs perception_service in lockstep on the cached simulator sequence, merges its output
 # log with the sequence's camera images (merge_lcm_logs) and renders the result with
 # `viewer` on file://...?speed=0: periodic snapshots every 2 s of message time in the
@@ -18,7 +19,7 @@ for tool in viewer merge_lcm_logs perception_service mbslam-sim; do
 done
 out="$MBSLAM_EVAL_OUT"
 seq=$(sim_sequence "$scenario" "$frames")
-run_service "$seq/sequence.lcmlog" "$out/run"
+run_service "$seq/sequence.lcmlog" "$out/run" ${SERVICE_ARGS:-}
 "$MBSLAM_BIN/merge_lcm_logs" "$out/merged.lcmlog" "$seq/sequence.lcmlog" "$out/run/out.lcmlog" >&2
 
 view() {  # view NAME [viewer --set args...]
