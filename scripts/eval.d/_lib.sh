@@ -1,13 +1,16 @@
 # Shared helpers for the evaluations in scripts/eval.d (sourced, not run).
 
 # sim_sequence SCENARIO [FRAMES] -> prints the sequence folder (generated once, cached).
+# SIM_SEED=S (default 1) renders the same scenario (same geometry and motions) with other
+# textures: the spread over seeds shows how much a figure owes to one rendering.
 sim_sequence() {
-  local scenario="$1" frames="${2:-300}"
+  local scenario="$1" frames="${2:-300}" seed="${SIM_SEED:-1}"
   local dir="$MBSLAM_ROOT/out/sim_cache/${scenario}-${frames}"
+  if [[ "$seed" != 1 ]]; then dir+="-seed$seed"; fi
   if [[ ! -f "$dir/sequence.lcmlog" ]]; then
     rm -rf "$dir"
     mkdir -p "$(dirname "$dir")"
-    "$MBSLAM_BIN/mbslam-sim" --quiet --scenario "$scenario" --frames "$frames" --out "$dir" >&2
+    "$MBSLAM_BIN/mbslam-sim" --quiet --scenario "$scenario" --frames "$frames" --seed "$seed" --out "$dir" >&2
   fi
   echo "$dir"
 }
