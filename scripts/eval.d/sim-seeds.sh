@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Scenario evaluations over several renderings (texture seeds) of the same scenes: mean, min and max of each key, so that a figure is not one rendering's luck
+#
+#   scripts/eval.sh sim-seeds [--scenarios "crossing following multi"] [--seeds "1 2 3"]
+#   (env SERVICE_ARGS="--set a.b=v ..." passes options to the service)
+#
+# SIM_SEED changes the textures and with them the features; the geometry, the motions and
+# the truth stay. Each run is the scenario's own evaluation (sim-NAME), in lockstep;
+# outputs in MBSLAM_EVAL_OUT/NAME-seedS/. JSON (last line): {"NAME": {"KEY": {"mean",
+# "min", "max", "values"}, ...}, ...} over the keys below; a key a run could not compute
+# is left out of that run's values.
+set -euo pipefail
+source "$(dirname "$0")/_lib.sh"
+scenarios="crossing following multi"
+seeds="1 2 3"
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --scenarios) scenarios="$2"; shift 2 ;;
+    --seeds) seeds="$2"; shift 2 ;;
+    *) echo "sim-seeds: unknown argument $1" >&2; echo '{}'; exit 2 ;;
+  esac
+done
+results=()
+for name in $scenarios; do
+  for seed in $seeds; do
+    out="$MBSLAM_EVAL_OUT/$name-seed$seed"
+    mkdir -p "$out"
+    echo "== sim-$name, texture seed $seed" >&2
+    line=$(SIM_SEED="$seed" MBSLAM_EVAL_OUT="$out" "$MBSLAM_ROOT/scripts/eval.d/sim-$name.sh" 2>"$out/eval.log" | tail -1) || true
+    [[ "$line" == "{"* ]] || line="{}"
+    echo "$line" >"$out/result.json"
+    results+=("$name" "$seed" "$out/result.json")
+  done
+done
+python3 - "${results[@]}" <<'PY'
+import json, sys
+keys = ["ate_rel_path", "tracked_fraction", "moving_recall", "moving_precision", "object_pos_err_rel_2s",
+        "relative_scale_error", "predicted_hit_rate_0_5s", "predicted_hit_rate_1s", "occupancy_precision",
+        "occupancy_recall", "object_traj_err_rel", "object_shape_err_rel", "track_misclassification"]
+args = sys.argv[1:]
+runs = {}
+for i in range(0, len(args), 3):
+    name, seed, path = args[i], args[i + 1], args[i + 2]
+    try:
+        d = json.load(open(path))
+    except Exception:
+        d = {}
+    runs.setdefault(name, []).append((seed, d))
+out = {}
+for name, rs in runs.items():
+    agg = {}
+    print(f"sim-{name} over texture seeds {' '.join(s for s, _ in rs)}:")
+    for k in keys:
+        vals = [d[k] for _, d in rs if isinstance(d.get(k), (int, float))]
+        if not vals:
+            continue
+        agg[k] = {"mean": sum(vals) / len(vals), "min": min(vals), "max": max(vals), "values": vals}
+        print(f"  {k:26s} mean {agg[k]['mean']:.4g}  min {min(vals):.4g}  max {max(vals):.4g}  ({', '.join(f'{v:.4g}' for v in vals)})")
+    out[name] = agg
+print(json.dumps(out))
+PY
