@@ -34,7 +34,7 @@ for name in $scenarios; do
 done
 python3 - "${results[@]}" <<'PY'
 import json, sys
-keys = ["ate_rel_path", "tracked_fraction", "moving_recall", "moving_precision", "object_pos_err_rel_2s",
+keys = ["ate_rel_path", "tracked_fraction", "scale_error", "moving_recall", "moving_precision", "object_pos_err_rel_2s",
         "relative_scale_error", "predicted_hit_rate_0_5s", "predicted_hit_rate_1s", "occupancy_precision",
         "occupancy_recall", "object_traj_err_rel", "object_shape_err_rel", "track_misclassification"]
 args = sys.argv[1:]
