@@ -1,8 +1,8 @@
-// Front-end cost per image at 640x480 with ~1000 tracks: the image pyramid with its
-// gradients (the service's preprocessing), feature tracking (KLT, forward-backward and
-// appearance checks, new detections) and motion segmentation (world motion, epipolar +
-// FVB likelihood, Bayes update, clustering), on a textured scene seen by a camera
-// translating and yawing, with a patch moving independently. The time is all three; the
+// Front-end cost per image at 640x480 with ~1000 tracks: the image pyramid (the service's
+// preprocessing), feature tracking (KLT, forward-backward and appearance checks, new
+// detections) and motion segmentation (world motion, epipolar + FVB likelihood, Bayes
+// update, clustering), on a textured scene seen by a camera translating and yawing, with
+// a patch moving independently. The time is all three; the
 // counters give each part (preprocess_ms, tracking_ms, segmentation_ms).
 //
 //   build/bin/frontend_bench [--benchmark_...]
@@ -66,10 +66,9 @@ void BM_TrackingAndSegmentation(benchmark::State& state) {
   // Warm up so that the tracks and histories exist.
   auto step = [&](int64_t i) {
     const Clock::time_point tp = Clock::now();
-    // As the service's preprocessing stage: a fresh pyramid with its gradients, every image.
+    // As the service's preprocessing stage: a fresh pyramid every image.
     std::vector<cv::Mat> pyramid;
-    cv::buildOpticalFlowPyramid(frames[static_cast<size_t>(i % 60)], pyramid, cv::Size(21, 21), 3,
-                                /*withDerivatives=*/true);
+    cv::buildOpticalFlowPyramid(frames[static_cast<size_t>(i % 60)], pyramid, cv::Size(21, 21), 3);
     const Clock::time_point t0 = Clock::now();
     tracker.TrackFrame(pyramid, i, TrackingHints());
     const Clock::time_point t1 = Clock::now();

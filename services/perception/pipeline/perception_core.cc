@@ -407,10 +407,8 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     pyramid_ = std::vector<cv::Mat>();
     // The pyramid's border must hold the KLT window (OpenCV asserts otherwise).
     const int border_win = std::max({21, options_.tracking.klt_window_px, options_.tracking.klt_fast_window_px});
-    // With the gradients: KLT then computes them once per image instead of once per call
-    // (forward, retry and backward passes, and per thread).
     cv::buildOpticalFlowPyramid(frame.gray, pyramid_, cv::Size(border_win, border_win),
-                                options_.preprocess.pyramid_levels - 1, /*withDerivatives=*/true);
+                                options_.preprocess.pyramid_levels - 1);
   }
 
   // Tracking, with the previous image's moving hulls as occluders (feedback from

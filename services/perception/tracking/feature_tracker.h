@@ -169,9 +169,8 @@ class FeatureTracker {
  public:
   explicit FeatureTracker(const TrackerOptions& options);
 
-  // Tracks into the new image, then detects new features in empty grid cells. `pyramid`
-  // is cv::buildOpticalFlowPyramid's output, with or without the gradients (with them KLT
-  // does not recompute them for every pass); element 0 is the full-resolution image. The tracker keeps `pyramid` (shallow cv::Mat copies)
+  // Tracks into the new image (pyramid level 0 = full resolution), then detects new
+  // features in empty grid cells. The tracker keeps `pyramid` (shallow cv::Mat copies)
   // as the previous image: the caller must not write into its buffers afterwards.
   void TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t frame_index, const TrackingHints& hints);
 
