@@ -213,11 +213,11 @@ int PoseFromEssential(const cv::Mat& E, const std::vector<cv::Point2d>& pr, cons
     int good = 0;
     for (int i = 0; i < Q.cols; ++i) {
       const double w = Q.at<double>(3, i);
-      if (!(Q.at<double>(2, i) * w > 0.0)) continue;
-      const cv::Vec4d X(Q.at<double>(0, i) / w, Q.at<double>(1, i) / w, Q.at<double>(2, i) / w, w / w);
-      if (!(X[2] < max_depth)) continue;
-      double z_n = 0.0;
-      for (int k = 0; k < 4; ++k) z_n += P1.at<double>(2, k) * X[k];
+      if (!(Q.at<double>(2, i) * w > 0.0)) continue;  // also excludes w == 0
+      const Eigen::Vector3d X(Q.at<double>(0, i) / w, Q.at<double>(1, i) / w, Q.at<double>(2, i) / w);
+      if (!(X.z() < max_depth)) continue;
+      const double z_n = P1.at<double>(2, 0) * X.x() + P1.at<double>(2, 1) * X.y() + P1.at<double>(2, 2) * X.z() +
+                         P1.at<double>(2, 3);
       if (z_n > 0.0 && z_n < max_depth) ++good;
     }
     if (2 * good >= screen[best]) {
