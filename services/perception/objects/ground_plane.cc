@@ -112,6 +112,16 @@ std::vector<Eigen::Vector3d> SpreadDirections(const std::vector<Eigen::Vector3d>
   return out;
 }
 
+double SpreadAlong(const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& direction) {
+  if (centres.empty()) return 0.0;
+  double mean = 0.0;
+  for (const Eigen::Vector3d& c : centres) mean += c.dot(direction);
+  mean /= static_cast<double>(centres.size());
+  double var = 0.0;
+  for (const Eigen::Vector3d& c : centres) var += (c.dot(direction) - mean) * (c.dot(direction) - mean);
+  return std::sqrt(var / static_cast<double>(centres.size()));
+}
+
 Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
                            const Eigen::Vector3d& up_hint, const GroundPlaneOptions& options,
                            const std::vector<Eigen::Vector3d>& in_plane_directions,
@@ -202,6 +212,45 @@ Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
   estimate->num_inliers = count;
   estimate->inlier_ratio = ratio;
   estimate->rms = std::sqrt(sq / static_cast<double>(count));
+  return Status::Ok();
+}
+
+Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up_hint,
+                                      const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& camera,
+                                      const GroundPlaneOptions& options, GroundPlaneEstimate* estimate,
+                                      bool* along_travel) {
+  if (estimate == nullptr || along_travel == nullptr) return Status::Error("EstimateGroundPlaneAlongTravel: null output");
+  *along_travel = false;
+  GroundPlaneEstimate free_fit;
+  Status status = EstimateGroundPlane(points, up_hint, options, &free_fit);
+  if (!status.ok()) return status;
+  if (free_fit.inlier_ratio < options.min_support) {
+    return Status::Error("EstimateGroundPlaneAlongTravel: the plane holds " + std::to_string(free_fit.inlier_ratio) +
+                         " of the points, below min_support");
+  }
+  *estimate = free_fit;
+  const double h = free_fit.plane.Height(camera);
+  if (centres.empty() || options.path_parallel_min_spread <= 0.0 || !(h > 0.0)) return Status::Ok();
+  const double min_spread = options.path_parallel_min_spread;
+  std::vector<Eigen::Vector3d> directions =
+      SpreadDirections(centres, free_fit.plane.normal, options.max_tilt_deg, min_spread * h);
+  const bool short_travel = directions.empty();
+  if (short_travel) {
+    directions = SpreadDirections(centres, free_fit.plane.normal, options.max_tilt_deg, 0.0);
+    if (directions.empty()) return Status::Ok();
+    directions.resize(1);  // the longest
+  }
+  GroundPlaneEstimate constrained;
+  if (!EstimateGroundPlane(points, up_hint, options, directions, &constrained).ok() ||
+      constrained.inlier_ratio < options.min_support) {
+    return Status::Ok();
+  }
+  if (short_travel) {
+    const double hc = constrained.plane.Height(camera);
+    if (!(hc > 0.0) || SpreadAlong(centres, directions.front()) < min_spread * hc) return Status::Ok();
+  }
+  *estimate = constrained;
+  *along_travel = true;
   return Status::Ok();
 }
 

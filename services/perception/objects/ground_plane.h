@@ -121,6 +121,25 @@ Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
 std::vector<Eigen::Vector3d> SpreadDirections(const std::vector<Eigen::Vector3d>& centres,
                                               const Eigen::Vector3d& up, double max_tilt_deg,
                                               double min_spread);
+// Standard deviation of `centres` along the unit `direction` (units).
+double SpreadAlong(const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& direction);
+
+// The ground under a camera that rides at a constant height (a robot's), with the
+// pipeline's use rules: the free fit (EstimateGroundPlane) must hold min_support of the
+// points. When the keyframe centres spread along a near-horizontal direction by at least
+// path_parallel_min_spread camera heights above that plane, the plane is refitted to
+// contain that direction (a small tilt of a plane fitted to distant points alone would
+// make the camera's height above it drift as it moves). When they do not, the free fit
+// may be far off: its inlier band is in map units, and when the map's unit is tens of
+// camera heights (a low camera looking down a long street) a plane tilted by 20 deg can
+// gather more points than the ground. Then the plane fitted along the longest direction
+// of travel is taken if the travel is long enough measured against the camera's height
+// above that plane. Either refit needs min_support. `centres` empty: the free fit.
+// `camera` is the latest camera centre; `along_travel` says which plane was returned.
+Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up_hint,
+                                      const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& camera,
+                                      const GroundPlaneOptions& options, GroundPlaneEstimate* estimate,
+                                      bool* along_travel);
 
 }  // namespace mbslam
 

@@ -132,5 +132,53 @@ TEST(GroundPlane, NormalPerpendicularToTheCamerasTravel) {
   EXPECT_TRUE(SpreadDirections(lift, Eigen::Vector3d::UnitZ(), 25.0, 1.0).empty());
 }
 
+// A low camera (0.03 units) looking down a long street: the map's inlier band (0.05
+// units) is wider than the camera's height, and a slope ahead holding more points than
+// the ground wins the free fit, 20 deg off. The travel (0.1 units along x) is short
+// against the camera's height above that plane (0.05) but long against its height above
+// the plane fitted along it (0.03): that one, the ground, is taken.
+TEST(GroundPlane, AlongTravelRejectsASlopeThatOutnumbersTheGround) {
+  ParticleRng rng(7);
+  std::vector<Eigen::Vector3d> points;
+  const double h = 0.03, slope = 20.0 * M_PI / 180.0;
+  for (int i = 0; i < 400; ++i) {
+    points.emplace_back(rng.Uniform(0.1, 1.5), rng.Uniform(-0.3, 0.3), -h + rng.Normal(0.0, 0.01));
+  }
+  for (int i = 0; i < 500; ++i) {
+    const double x = rng.Uniform(0.6, 1.5);
+    points.emplace_back(x, rng.Uniform(-0.3, 0.3), -0.09 + std::tan(slope) * x + rng.Normal(0.0, 0.01));
+  }
+  GroundPlaneOptions options;
+  options.inlier_threshold = 0.05;
+  GroundPlaneEstimate free_fit;
+  ASSERT_TRUE(EstimateGroundPlane(points, Eigen::Vector3d::UnitZ(), options, &free_fit).ok());
+  EXPECT_GT(std::abs(free_fit.plane.normal.x()), std::sin(15.0 * M_PI / 180.0));  // the slope won
+  std::vector<Eigen::Vector3d> centres;
+  for (int k = 0; k < 12; ++k) centres.emplace_back(0.01 * k, 0.0, 0.0);  // spread 0.034
+  const Eigen::Vector3d camera = centres.back();
+  GroundPlaneEstimate estimate;
+  bool along = false;
+  ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), centres, camera, options, &estimate,
+                                             &along).ok());
+  EXPECT_TRUE(along);
+  EXPECT_GT(estimate.plane.normal.z(), 0.999);
+  EXPECT_NEAR(estimate.plane.Height(camera), h, 0.005);
+  // Travel too short even against the ground's height: the free fit stays.
+  std::vector<Eigen::Vector3d> short_travel;
+  for (int k = 0; k < 12; ++k) short_travel.emplace_back(0.002 * k, 0.0, 0.0);
+  ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_travel, short_travel.back(),
+                                             options, &estimate, &along).ok());
+  EXPECT_FALSE(along);
+  EXPECT_NEAR(estimate.plane.normal.x(), free_fit.plane.normal.x(), 1e-12);
+  // No travel given (camera height unknown): the free fit.
+  ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate,
+                                             &along).ok());
+  EXPECT_FALSE(along);
+  // Below min_support: an error, no plane.
+  options.min_support = 0.9;
+  EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), centres, camera, options, &estimate,
+                                              &along).ok());
+}
+
 }  // namespace
 }  // namespace mbslam

@@ -171,29 +171,17 @@ void PerceptionCore::UpdateGroundPlane() {
   // Up: minus the first keyframe camera's y axis (cameras are held roughly level).
   const Rigid3d& first = map.keyframes().begin()->second.cam_from_world;
   const Eigen::Vector3d up = -(first.RotationMatrix().transpose() * Eigen::Vector3d::UnitY());
-  GroundPlaneEstimate estimate;
-  if (!EstimateGroundPlane(points, up, options_.ground, &estimate).ok() ||
-      estimate.inlier_ratio < options_.ground.min_support) {
-    return;
-  }
   const Eigen::Vector3d camera = map.LastKeyframe()->cam_from_world.Inverse().translation;
-  bool along_path = false;
-  if (options_.objects.camera_height_m > 0.0 && options_.ground.path_parallel_min_spread > 0.0) {
-    // The camera rides at a constant height: its travel lies in a plane parallel to the
-    // ground. A small tilt of a plane fitted to distant points alone would make the
-    // camera's height above it (and the metres per unit, the ground cues) drift as it moves.
-    const double h = estimate.plane.Height(camera);
-    std::vector<Eigen::Vector3d> centres;
+  // A camera at a known height rides at a constant height: its travel lies in a plane
+  // parallel to the ground.
+  std::vector<Eigen::Vector3d> centres;
+  if (options_.objects.camera_height_m > 0.0) {
     for (const auto& [id, k] : map.keyframes()) centres.push_back(k.cam_from_world.Inverse().translation);
-    const std::vector<Eigen::Vector3d> directions = SpreadDirections(
-        centres, estimate.plane.normal, options_.ground.max_tilt_deg, options_.ground.path_parallel_min_spread * h);
-    GroundPlaneEstimate constrained;
-    if (h > 0.0 && !directions.empty() &&
-        EstimateGroundPlane(points, up, options_.ground, directions, &constrained).ok() &&
-        constrained.inlier_ratio >= options_.ground.min_support) {
-      estimate = constrained;
-      along_path = true;
-    }
+  }
+  GroundPlaneEstimate estimate;
+  bool along_path = false;
+  if (!EstimateGroundPlaneAlongTravel(points, up, centres, camera, options_.ground, &estimate, &along_path).ok()) {
+    return;
   }
   ground_ = estimate.plane;
   MBSLAM_LOG(DEBUG) << "ground plane: n " << estimate.plane.normal.transpose() << " d " << estimate.plane.offset
