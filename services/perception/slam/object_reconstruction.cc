@@ -8,6 +8,34 @@
 
 namespace mbslam {
 
+namespace {
+
+double MedianOf(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& points, double max_spread) {
+  if (max_spread <= 0.0 || points.size() < 8) return points;
+  std::vector<double> coords[3];
+  for (const Eigen::Vector3d& p : points) {
+    for (int a = 0; a < 3; ++a) coords[a].push_back(p[a]);
+  }
+  const Eigen::Vector3d centre(MedianOf(coords[0]), MedianOf(coords[1]), MedianOf(coords[2]));
+  std::vector<double> distances;
+  distances.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) distances.push_back((p - centre).norm());
+  const double limit = max_spread * MedianOf(distances);
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) {
+    if ((p - centre).norm() <= limit) kept.push_back(p);
+  }
+  return kept;
+}
+
 SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOptions& options,
                                                     const SlamOptions& slam) {
   SlamOptions s = slam;
@@ -133,8 +161,11 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
       if (update.new_keyframe || e.last_points_frame < 0 ||
           frame_index - e.last_points_frame >= options_.points_every_frames) {
         r.points_included = true;
-        r.points.reserve(e.slam->map().num_points());
-        for (const auto& [pid, p] : e.slam->map().points()) r.points.push_back(p.position);
+        std::vector<Eigen::Vector3d> all;
+        all.reserve(e.slam->map().num_points());
+        for (const auto& [pid, p] : e.slam->map().points()) all.push_back(p.position);
+        r.points = CompactPoints(all, options_.max_point_spread);
+        r.points_left_out = static_cast<int>(all.size() - r.points.size());
         e.last_points_frame = frame_index;
       }
     }

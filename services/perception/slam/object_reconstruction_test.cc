@@ -116,5 +116,25 @@ TEST(ObjectReconstructionTest, ChoosesLargestObjectsAndForgetsGoneOnes) {
   EXPECT_TRUE(none.Update(0, 0, 500.0, {object(2, 30)}).empty());
 }
 
+// Published object points leave out what lies far outside the body: on sim-crossing an
+// object map held points 9 and 6000 units away from a body 0.16 units across, which the
+// objects' point clouds carried into the world for planners.
+TEST(ObjectReconstructionTest, PublishedPointsLeaveOutPointsFarOutsideTheBody) {
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 60; ++i) {
+    points.emplace_back(5.0 + 0.1 * (i % 5), 0.1 * ((i / 5) % 4) - 0.15, 0.05 * (i / 20));
+  }
+  const std::vector<Eigen::Vector3d> body = points;
+  points.emplace_back(14.0, 0.0, 0.0);
+  points.emplace_back(6000.0, 10.0, -3.0);
+  points.emplace_back(5.2, 2.5, 0.0);
+  const std::vector<Eigen::Vector3d> kept = CompactPoints(points, 4.0);
+  ASSERT_EQ(kept.size(), body.size());
+  for (size_t i = 0; i < body.size(); ++i) EXPECT_EQ(kept[i], body[i]);  // the body, in order
+  EXPECT_EQ(CompactPoints(points, 0.0).size(), points.size());  // 0: everything
+  const std::vector<Eigen::Vector3d> few(points.end() - 5, points.end());
+  EXPECT_EQ(CompactPoints(few, 4.0).size(), few.size());  // too few to tell the body
+}
+
 }  // namespace
 }  // namespace mbslam
