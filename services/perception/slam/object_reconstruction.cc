@@ -165,7 +165,6 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
         all.reserve(e.slam->map().num_points());
         for (const auto& [pid, p] : e.slam->map().points()) all.push_back(p.position);
         r.points = CompactPoints(all, options_.max_point_spread);
-        r.points_left_out = static_cast<int>(all.size() - r.points.size());
         e.last_points_frame = frame_index;
       }
     }

@@ -96,7 +96,6 @@ struct ObjectReconstructionResult {
   double median_depth = 0.0;       // median camera depth of the object's points seen in this image (object units)
   bool points_included = false;    // `points` holds the map (at a keyframe or every points_every_frames)
   std::vector<Eigen::Vector3d> points;  // the object's points, object frame (object map units)
-  int points_left_out = 0;         // map points not in `points`: outside the body (max_point_spread)
 };
 
 // The points within `max_spread` times their median distance to their coordinate-wise
