@@ -230,7 +230,10 @@ Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points
   }
   *estimate = free_fit;
   const double h = free_fit.plane.Height(camera);
-  if (centres.empty() || options.path_parallel_min_spread <= 0.0 || !(h > 0.0)) return Status::Ok();
+  if (!(h > 0.0)) {
+    return Status::Error("EstimateGroundPlaneAlongTravel: the camera is " + std::to_string(-h) + " below the plane");
+  }
+  if (centres.empty() || options.path_parallel_min_spread <= 0.0) return Status::Ok();
   const double min_spread = options.path_parallel_min_spread;
   std::vector<Eigen::Vector3d> directions =
       SpreadDirections(centres, free_fit.plane.normal, options.max_tilt_deg, min_spread * h);
@@ -241,16 +244,23 @@ Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points
     directions.resize(1);  // the longest
   }
   GroundPlaneEstimate constrained;
-  if (!EstimateGroundPlane(points, up_hint, options, directions, &constrained).ok() ||
-      constrained.inlier_ratio < options.min_support) {
+  bool use_constrained = EstimateGroundPlane(points, up_hint, options, directions, &constrained).ok() &&
+                         constrained.inlier_ratio >= options.min_support;
+  const double hc = constrained.plane.Height(camera);
+  if (use_constrained) use_constrained = hc > 0.0;
+  if (use_constrained && short_travel) use_constrained = SpreadAlong(centres, directions.front()) >= min_spread * hc;
+  if (use_constrained) {
+    *estimate = constrained;
+    *along_travel = true;
     return Status::Ok();
   }
-  if (short_travel) {
-    const double hc = constrained.plane.Height(camera);
-    if (!(hc > 0.0) || SpreadAlong(centres, directions.front()) < min_spread * hc) return Status::Ok();
+  // No plane along the travel: the free fit stays only if the travel does not contradict
+  // it (a camera that rides at a constant height moves parallel to the ground).
+  const double tilt = std::asin(std::min(1.0, std::abs(free_fit.plane.normal.dot(directions.front().normalized()))));
+  if (tilt > options.max_travel_tilt_deg * M_PI / 180.0) {
+    return Status::Error("EstimateGroundPlaneAlongTravel: the plane is tilted " + std::to_string(tilt * 180.0 / M_PI) +
+                         " deg from the camera's travel");
   }
-  *estimate = constrained;
-  *along_travel = true;
   return Status::Ok();
 }
 

@@ -47,6 +47,9 @@ struct GroundPlaneOptions {
   // perpendicular to the near-horizontal directions its keyframes spread along by at least
   // this many camera heights (standard deviation of the centres); 0 = never.
   double path_parallel_min_spread = 1.0;
+  // Camera at a known height: without a plane along its travel, a plane tilted from the
+  // direction of travel by more than this is not the ground (deg).
+  double max_travel_tilt_deg = 10.0;
   int64_t seed = 1;                // RANSAC sampling seed (deterministic)
   // Use of the plane by the perception pipeline.
   double min_support = 0.3;  // a plane is used only if this share of the map points lies on it [0, 1]
@@ -66,6 +69,7 @@ struct GroundPlaneOptions {
     MBSLAM_CHECK_OPTION(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GE(refine_iterations, 0);
     MBSLAM_CHECK_OPTION_GE(path_parallel_min_spread, 0.0);
+    MBSLAM_CHECK_OPTION(max_travel_tilt_deg > 0.0 && max_travel_tilt_deg <= 90.0);
     MBSLAM_CHECK_OPTION(min_support >= 0.0 && min_support <= 1.0);
     MBSLAM_CHECK_OPTION_GE(depth_bound_margin, 0.0);
     MBSLAM_CHECK_OPTION(depth_bound_min_elevation_deg > 0.0 && depth_bound_min_elevation_deg < 90.0);
@@ -82,6 +86,8 @@ struct GroundPlaneOptions {
     v("refine_iterations", &refine_iterations, "least-squares refits (count)");
     v("path_parallel_min_spread", &path_parallel_min_spread,
       "camera at a known height: normal perpendicular to keyframe spreads of at least this many camera heights; 0 never");
+    v("max_travel_tilt_deg", &max_travel_tilt_deg,
+      "camera at a known height, no plane along its travel: a plane tilted more from the travel is not the ground (deg)");
     v("seed", &seed, "RANSAC sampling seed");
     v("min_support", &min_support, "a plane is used only if this share of the map points lies on it [0, 1]");
     v("depth_bound_margin", &depth_bound_margin,
@@ -126,7 +132,7 @@ double SpreadAlong(const std::vector<Eigen::Vector3d>& centres, const Eigen::Vec
 
 // The ground under a camera that rides at a constant height (a robot's), with the
 // pipeline's use rules: the free fit (EstimateGroundPlane) must hold min_support of the
-// points. When the keyframe centres spread along a near-horizontal direction by at least
+// points and lie below `camera`. When the keyframe centres spread along a near-horizontal direction by at least
 // path_parallel_min_spread camera heights above that plane, the plane is refitted to
 // contain that direction (a small tilt of a plane fitted to distant points alone would
 // make the camera's height above it drift as it moves). When they do not, the free fit
@@ -134,8 +140,10 @@ double SpreadAlong(const std::vector<Eigen::Vector3d>& centres, const Eigen::Vec
 // camera heights (a low camera looking down a long street) a plane tilted by 20 deg can
 // gather more points than the ground. Then the plane fitted along the longest direction
 // of travel is taken if the travel is long enough measured against the camera's height
-// above that plane. Either refit needs min_support. `centres` empty: the free fit.
-// `camera` is the latest camera centre; `along_travel` says which plane was returned.
+// above that plane. Either refit needs min_support. Without a refit, a free fit tilted
+// from the longest direction of travel by more than max_travel_tilt_deg is refused (an
+// error: no plane). `centres` empty: the free fit. `camera` is the latest camera centre;
+// `along_travel` says which plane was returned.
 Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up_hint,
                                       const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& camera,
                                       const GroundPlaneOptions& options, GroundPlaneEstimate* estimate,

@@ -163,10 +163,16 @@ TEST(GroundPlane, AlongTravelRejectsASlopeThatOutnumbersTheGround) {
   EXPECT_TRUE(along);
   EXPECT_GT(estimate.plane.normal.z(), 0.999);
   EXPECT_NEAR(estimate.plane.Height(camera), h, 0.005);
-  // Travel too short even against the ground's height: the free fit stays.
-  std::vector<Eigen::Vector3d> short_travel;
-  for (int k = 0; k < 12; ++k) short_travel.emplace_back(0.002 * k, 0.0, 0.0);
-  ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_travel, short_travel.back(),
+  // Travel too short even against the ground's height, along x: the slope contradicts
+  // it, so there is no plane. Along y (across the slope's tilt) the free fit stays.
+  std::vector<Eigen::Vector3d> short_travel, short_across;
+  for (int k = 0; k < 12; ++k) {
+    short_travel.emplace_back(0.002 * k, 0.0, 0.0);
+    short_across.emplace_back(0.0, 0.002 * k, 0.0);
+  }
+  EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_travel, short_travel.back(),
+                                              options, &estimate, &along).ok());
+  ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_across, short_across.back(),
                                              options, &estimate, &along).ok());
   EXPECT_FALSE(along);
   EXPECT_NEAR(estimate.plane.normal.x(), free_fit.plane.normal.x(), 1e-12);
@@ -174,6 +180,9 @@ TEST(GroundPlane, AlongTravelRejectsASlopeThatOutnumbersTheGround) {
   ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate,
                                              &along).ok());
   EXPECT_FALSE(along);
+  // A camera below the plane: no ground.
+  EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, Eigen::Vector3d(0.1, 0.0, -0.5),
+                                              options, &estimate, &along).ok());
   // Below min_support: an error, no plane.
   options.min_support = 0.9;
   EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), centres, camera, options, &estimate,
