@@ -13,6 +13,16 @@ namespace mbslam {
 
 bool MotionSegmenter::TrackState::At(int64_t frame, Eigen::Vector2d* xy_out,
                                      Eigen::Vector2d* uv_out) const {
+  // Tracks are usually observed in every image: then the frame sits at a fixed offset
+  // from the newest observation.
+  if (!frames.empty() && frame <= frames.back() && frames.back() - frame < static_cast<int64_t>(frames.size())) {
+    const size_t k = frames.size() - 1 - static_cast<size_t>(frames.back() - frame);
+    if (frames[k] == frame) {
+      if (xy_out) *xy_out = xy[k];
+      if (uv_out) *uv_out = uv[k];
+      return true;
+    }
+  }
   for (size_t k = frames.size(); k-- > 0;) {
     if (frames[k] == frame) {
       if (xy_out) *xy_out = xy[k];
