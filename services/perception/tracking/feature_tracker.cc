@@ -525,11 +525,41 @@ void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
     ++count[static_cast<size_t>(cell_of(t.uv.x(), t.uv.y()))];
   }
 
-  std::vector<cv::KeyPoint> keypoints;
-  cv::FAST(image, keypoints, options_.fast_threshold, /*nonmaxSuppression=*/true);
+  // FAST only where features are wanted: over each run of neighbouring cells of a grid
+  // row that lack them, grown by 5 px (the 3-px circle and the non-maximum neighbours),
+  // keeping the corners of those cells: the same corners, in the same order, as FAST
+  // over the whole image would give them.
+  std::vector<std::vector<cv::KeyPoint>> runs;
+  const int kMargin = 5;
+  for (int cy = 0; cy < options_.grid_rows; ++cy) {
+    for (int cx = 0; cx < options_.grid_cols;) {
+      if (count[static_cast<size_t>(cy * options_.grid_cols + cx)] >= per_cell) {
+        ++cx;
+        continue;
+      }
+      int end = cx + 1;
+      while (end < options_.grid_cols && count[static_cast<size_t>(cy * options_.grid_cols + end)] < per_cell) ++end;
+      const int x0 = std::max(0, static_cast<int>(std::floor(cx * cell_w)) - kMargin);
+      const int x1 = std::min(image.cols, static_cast<int>(std::ceil(end * cell_w)) + kMargin);
+      const int y0 = std::max(0, static_cast<int>(std::floor(cy * cell_h)) - kMargin);
+      const int y1 = std::min(image.rows, static_cast<int>(std::ceil((cy + 1) * cell_h)) + kMargin);
+      std::vector<cv::KeyPoint> found;
+      if (x1 - x0 > 7 && y1 - y0 > 7) {
+        cv::FAST(image(cv::Rect(x0, y0, x1 - x0, y1 - y0)), found, options_.fast_threshold, /*nonmaxSuppression=*/true);
+      }
+      std::vector<cv::KeyPoint>& kept = runs.emplace_back();
+      for (cv::KeyPoint& kp : found) {
+        kp.pt.x += static_cast<float>(x0);
+        kp.pt.y += static_cast<float>(y0);
+        const int c = cell_of(kp.pt.x, kp.pt.y);
+        if (c / options_.grid_cols == cy && c % options_.grid_cols >= cx && c % options_.grid_cols < end) kept.push_back(kp);
+      }
+      cx = end;
+    }
+  }
   std::vector<std::vector<const cv::KeyPoint*>> by_cell(static_cast<size_t>(cells));
-  for (const cv::KeyPoint& kp : keypoints) {
-    by_cell[static_cast<size_t>(cell_of(kp.pt.x, kp.pt.y))].push_back(&kp);
+  for (const std::vector<cv::KeyPoint>& run : runs) {
+    for (const cv::KeyPoint& kp : run) by_cell[static_cast<size_t>(cell_of(kp.pt.x, kp.pt.y))].push_back(&kp);
   }
   // Empty cells get a second chance at the lower threshold.
   std::vector<std::vector<cv::KeyPoint>> extra(static_cast<size_t>(cells));
