@@ -8,16 +8,10 @@
 #include <sstream>
 
 #include "common/util/logging.h"
+#include "common/util/statistics.h"
 
 namespace mbslam {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  return v[mid];
-}
 
 Eigen::Vector2d Centroid(const std::vector<Eigen::Vector2d>& xy) {
   Eigen::Vector2d c = Eigen::Vector2d::Zero();

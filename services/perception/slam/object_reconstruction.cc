@@ -5,17 +5,9 @@
 #include <utility>
 
 #include "common/util/logging.h"
+#include "common/util/statistics.h"
 
 namespace mbslam {
-
-namespace {
-
-double MedianOf(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
 
 std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& points, double max_spread) {
   if (max_spread <= 0.0 || points.size() < 8) return points;
@@ -23,11 +15,11 @@ std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& p
   for (const Eigen::Vector3d& p : points) {
     for (int a = 0; a < 3; ++a) coords[a].push_back(p[a]);
   }
-  const Eigen::Vector3d centre(MedianOf(coords[0]), MedianOf(coords[1]), MedianOf(coords[2]));
+  const Eigen::Vector3d centre(Median(coords[0]), Median(coords[1]), Median(coords[2]));
   std::vector<double> distances;
   distances.reserve(points.size());
   for (const Eigen::Vector3d& p : points) distances.push_back((p - centre).norm());
-  const double limit = max_spread * MedianOf(distances);
+  const double limit = max_spread * Median(distances);
   std::vector<Eigen::Vector3d> kept;
   kept.reserve(points.size());
   for (const Eigen::Vector3d& p : points) {
@@ -154,10 +146,7 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
         const double d = (r.cam_from_obj * e.slam->map().point(pid)->position).z();
         if (d > 0.0) z.push_back(d);
       }
-      if (!z.empty()) {
-        std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
-        r.median_depth = z[z.size() / 2];
-      }
+      if (!z.empty()) r.median_depth = Median(z);
       if (update.new_keyframe || e.last_points_frame < 0 ||
           frame_index - e.last_points_frame >= options_.points_every_frames) {
         r.points_included = true;

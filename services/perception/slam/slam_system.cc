@@ -13,6 +13,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "common/util/logging.h"
+#include "common/util/statistics.h"
 #include "services/perception/geometry/polygon.h"
 #include "services/perception/slam/init_selection.h"
 #include "services/perception/slam/triangulation.h"
@@ -25,12 +26,6 @@ constexpr double kDeg = M_PI / 180.0;
 // Grid of the initialisation's coverage test (cells across, down).
 constexpr int kInitGridCols = 8;
 constexpr int kInitGridRows = 6;
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 }  // namespace
 
