@@ -235,13 +235,15 @@ Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points
   }
   if (centres.empty() || options.path_parallel_min_spread <= 0.0) return Status::Ok();
   const double min_spread = options.path_parallel_min_spread;
-  std::vector<Eigen::Vector3d> directions =
-      SpreadDirections(centres, free_fit.plane.normal, options.max_tilt_deg, min_spread * h);
-  const bool short_travel = directions.empty();
+  // Near-horizontal directions of travel, the longest first: those long enough against
+  // the camera's height above the free fit, or else the longest alone (short travel).
+  std::vector<Eigen::Vector3d> directions = SpreadDirections(centres, free_fit.plane.normal, options.max_tilt_deg, 0.0);
+  if (directions.empty()) return Status::Ok();
+  const bool short_travel = SpreadAlong(centres, directions.front()) < min_spread * h;
   if (short_travel) {
-    directions = SpreadDirections(centres, free_fit.plane.normal, options.max_tilt_deg, 0.0);
-    if (directions.empty()) return Status::Ok();
-    directions.resize(1);  // the longest
+    directions.resize(1);
+  } else {
+    while (SpreadAlong(centres, directions.back()) < min_spread * h) directions.pop_back();
   }
   GroundPlaneEstimate constrained;
   bool use_constrained = EstimateGroundPlane(points, up_hint, options, directions, &constrained).ok() &&

@@ -529,16 +529,17 @@ void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
   // row that lack them, grown by 5 px (the 3-px circle and the non-maximum neighbours),
   // keeping the corners of those cells: the same corners, in the same order, as FAST
   // over the whole image would give them.
-  std::vector<std::vector<cv::KeyPoint>> runs;
+  std::vector<std::vector<cv::KeyPoint>> corners(static_cast<size_t>(cells));
   const int kMargin = 5;
   for (int cy = 0; cy < options_.grid_rows; ++cy) {
+    const int row = cy * options_.grid_cols;
     for (int cx = 0; cx < options_.grid_cols;) {
-      if (count[static_cast<size_t>(cy * options_.grid_cols + cx)] >= per_cell) {
+      if (count[static_cast<size_t>(row + cx)] >= per_cell) {
         ++cx;
         continue;
       }
       int end = cx + 1;
-      while (end < options_.grid_cols && count[static_cast<size_t>(cy * options_.grid_cols + end)] < per_cell) ++end;
+      while (end < options_.grid_cols && count[static_cast<size_t>(row + end)] < per_cell) ++end;
       const int x0 = std::max(0, static_cast<int>(std::floor(cx * cell_w)) - kMargin);
       const int x1 = std::min(image.cols, static_cast<int>(std::ceil(end * cell_w)) + kMargin);
       const int y0 = std::max(0, static_cast<int>(std::floor(cy * cell_h)) - kMargin);
@@ -547,19 +548,18 @@ void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
       if (x1 - x0 > 7 && y1 - y0 > 7) {
         cv::FAST(image(cv::Rect(x0, y0, x1 - x0, y1 - y0)), found, options_.fast_threshold, /*nonmaxSuppression=*/true);
       }
-      std::vector<cv::KeyPoint>& kept = runs.emplace_back();
       for (cv::KeyPoint& kp : found) {
         kp.pt.x += static_cast<float>(x0);
         kp.pt.y += static_cast<float>(y0);
         const int c = cell_of(kp.pt.x, kp.pt.y);
-        if (c / options_.grid_cols == cy && c % options_.grid_cols >= cx && c % options_.grid_cols < end) kept.push_back(kp);
+        if (c >= row + cx && c < row + end) corners[static_cast<size_t>(c)].push_back(kp);
       }
       cx = end;
     }
   }
   std::vector<std::vector<const cv::KeyPoint*>> by_cell(static_cast<size_t>(cells));
-  for (const std::vector<cv::KeyPoint>& run : runs) {
-    for (const cv::KeyPoint& kp : run) by_cell[static_cast<size_t>(cell_of(kp.pt.x, kp.pt.y))].push_back(&kp);
+  for (int c = 0; c < cells; ++c) {
+    for (const cv::KeyPoint& kp : corners[static_cast<size_t>(c)]) by_cell[static_cast<size_t>(c)].push_back(&kp);
   }
   // Empty cells get a second chance at the lower threshold.
   std::vector<std::vector<cv::KeyPoint>> extra(static_cast<size_t>(cells));
