@@ -14,6 +14,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "common/util/logging.h"
+#include "services/perception/geometry/patch_warp.h"
 #include "services/perception/geometry/polygon.h"
 
 namespace mbslam {
@@ -39,7 +40,8 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
       slam_(options.slam),
       object_tracking_(options.objects),
       object_reconstruction_(std::make_unique<ObjectReconstruction>(options.object_slam, options.slam)),
-      object_slam_timer_(timers->Get("object_slam")) {
+      object_slam_timer_(timers->Get("object_slam")),
+      warp_timer_(timers->Get("warp_alignment")) {
   const auto& q = options.odometry.base_from_cam_rotation;
   const auto& t = options.odometry.base_from_cam_translation;
   base_from_cam_ = Rigid3d(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), Eigen::Vector3d(t[0], t[1], t[2]));
@@ -47,6 +49,7 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
 
 void PerceptionCore::Reset() {
   slam_.Reset();
+  rereference_tracks_.clear();
   ground_.reset();
   occupancy_.reset();
   last_occupancy_publish_utime_.reset();
@@ -157,6 +160,81 @@ void PerceptionCore::FillCameraPose(const SlamPose& pose, CameraPoseOutput* out)
   out->scale_to_metric = pose.scale_to_metric;
   out->num_inliers = pose.num_inliers;
   out->num_keyframes = static_cast<int>(slam_.map().num_keyframes());
+}
+
+void PerceptionCore::AlignOnWarpedReferences(const Rigid3d& cam_from_world, const CameraIntrinsics& intrinsics,
+                                             SlamFrame* slam_frame) {
+  const Map& map = slam_.map();
+  // References are keyed by their keyframe's image index (keyframe ids restart with a
+  // new map; image indices do not).
+  std::unordered_map<int64_t, const Keyframe*> keyframe_of_image;
+  for (const auto& [id, kf] : map.keyframes()) keyframe_of_image[kf.frame_index] = &kf;
+  const double ground_band = options_.tracking.warp_ground_band;
+  const double rereference_scale = options_.tracking.warp_rereference_scale;
+  std::optional<double> camera_height;
+  if (ground_) camera_height = ground_->Height(cam_from_world.Inverse().translation);
+  const double max_scale = options_.tracking.warp_max_scale;
+  std::vector<WarpedReference> warps;
+  for (const Track& t : tracker_.tracks()) {
+    if (!t.active() || t.last_seen_frame != frame_index_ || t.body_id != 0) continue;
+    if ((t.id + frame_index_) % options_.tracking.warp_align_every != 0) continue;
+    const int64_t pid = map.PointOfTrack(t.id);
+    const MapPoint* point = pid >= 0 ? map.point(pid) : nullptr;
+    if (point == nullptr) continue;
+    auto kf_it = keyframe_of_image.find(t.warp_reference_key);
+    const Keyframe* kf = kf_it != keyframe_of_image.end() ? kf_it->second : nullptr;
+    if (kf == nullptr) {
+      rereference_tracks_.insert(t.id);
+      continue;
+    }
+    const Eigen::Vector3d ref_centre = kf->cam_from_world.Inverse().translation;
+    Eigen::Vector3d normal = ref_centre - point->position;
+    if (camera_height && *camera_height > 0.0 &&
+        std::abs(ground_->Height(point->position)) < ground_band * *camera_height) {
+      normal = ground_->normal;
+    }
+    const std::optional<Eigen::Matrix2d> warp = PlaneInducedAffineWarp(
+        intrinsics, kf->cam_from_world, cam_from_world, t.warp_reference_uv.cast<double>(), point->position, normal);
+    if (!warp) {
+      rereference_tracks_.insert(t.id);
+      continue;
+    }
+    const Eigen::Vector2d sv = SingularValues2x2(*warp);
+    if (sv[0] > rereference_scale || sv[1] < 1.0 / rereference_scale) rereference_tracks_.insert(t.id);
+    if (sv[0] > max_scale || sv[1] < 1.0 / max_scale) continue;
+    warps.push_back({t.id, warp->cast<float>()});
+  }
+  const WarpAlignStats stats = tracker_.AlignToReferences(warps);
+  MBSLAM_LOG(DEBUG) << "image " << frame_index_ << ": warp alignment tried " << stats.tried << ", corrected "
+                    << stats.corrected << " (mean " << stats.mean_correction_px << " px), refused " << stats.refused;
+  if (stats.corrected == 0) return;
+  std::unordered_map<int64_t, const Track*> track_of;
+  for (const Track& t : tracker_.tracks()) {
+    if (t.active() && t.last_seen_frame == frame_index_) track_of[t.id] = &t;
+  }
+  for (SlamObservation& o : slam_frame->observations) {
+    auto it = track_of.find(o.track_id);
+    if (it == track_of.end()) continue;
+    const Eigen::Vector2d uv = it->second->uv.cast<double>();
+    if (uv == o.uv) continue;
+    o.uv = uv;
+    o.xy = intrinsics.PixelToNormalized(uv);
+    o.patch = it->second->patch;
+  }
+}
+
+void PerceptionCore::SetWarpReferences() {
+  const Keyframe* kf = slam_.map().LastKeyframe();
+  if (kf == nullptr || kf->frame_index != frame_index_) return;
+  std::vector<std::pair<int64_t, int64_t>> keys;
+  for (const Track& t : tracker_.tracks()) {
+    if (!t.active() || t.last_seen_frame != frame_index_ || t.body_id != 0) continue;
+    if (t.warp_reference_key >= 0 && !rereference_tracks_.count(t.id)) continue;
+    if (slam_.map().PointOfTrack(t.id) < 0) continue;
+    keys.emplace_back(t.id, kf->frame_index);
+  }
+  tracker_.SetWarpReferences(keys);
+  rereference_tracks_.clear();
 }
 
 void PerceptionCore::UpdateGroundPlane() {
@@ -471,6 +549,11 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     }
   }
 
+  if (options_.tracking.warp_align && slam_pose.valid && slam_pose.state == SlamState::kTracking) {
+    ScopedStageTimer timer(warp_timer_);
+    AlignOnWarpedReferences(slam_pose.cam_from_world, intrinsics, &slam_frame);
+  }
+
   // Segmentation on the active tracks.
   SegmentationResult seg;
   {
@@ -551,6 +634,8 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       for (const auto& [id, body] : body_of) all_static[id] = 0;
       map_update = slam_.UpdateMap(slam_frame, all_static);
     }
+    // The new keyframe is the reference appearance of map tracks without a usable one.
+    if (map_update.new_keyframe && options_.tracking.warp_align) SetWarpReferences();
   }
   // Bundle adjustment time per run (solver wall time; in the back-end thread when
   // slam.background_ba, so not part of this image's time), recorded when a run is merged.

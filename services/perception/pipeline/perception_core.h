@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -146,6 +147,14 @@ class PerceptionCore : public FrameProcessor {
                        const std::vector<std::vector<Eigen::Vector2d>>& moving_hulls_xy, FrameResult* result);
   // SLAM's depth bound of a track, capped by where its ray meets the ground.
   DepthBound DepthBoundFor(int64_t track_id, const Eigen::Vector2d& xy, int64_t frame) const;
+  // Affine patch warps once this image's pose is known: static tracks with a map point are
+  // re-aligned on their reference appearance (from a keyframe) warped into this image
+  // through the local surface plane (the ground's when the point lies on it, else facing
+  // the reference camera); corrected positions replace the observations in `slam_frame`.
+  void AlignOnWarpedReferences(const Rigid3d& cam_from_world, const CameraIntrinsics& intrinsics,
+                               SlamFrame* slam_frame);
+  // At a new keyframe: static map tracks without a usable reference take this image.
+  void SetWarpReferences();
   MapOutput BuildMapOutput(int64_t utime) const;
   void FillObjectEstimate(const TrackedObject& tracked, ObjectOutput* out) const;
   void Reset();
@@ -173,6 +182,10 @@ class PerceptionCore : public FrameProcessor {
   ObjectTracking object_tracking_;
   std::unique_ptr<ObjectReconstruction> object_reconstruction_;
   TimingStats* object_slam_timer_;
+  TimingStats* warp_timer_;  // affine-warp re-alignment of tracks (after the pose)
+  // Tracks whose warp left the range where their reference is used well: re-referenced
+  // at the next keyframe.
+  std::unordered_set<int64_t> rereference_tracks_;
   std::unique_ptr<OccupancyMap> occupancy_;  // static world only (sec. 6.3); null until rays arrive
   int64_t occupancy_crops_counted_ = 0;    // occupancy_->crops() already on the counters
   int64_t occupancy_dropped_counted_ = 0;  // occupancy_->occupied_voxels_dropped() already counted

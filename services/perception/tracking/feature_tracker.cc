@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <unordered_map>
 
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
 #include "common/util/parallel_for.h"
+#include "services/perception/geometry/patch_warp.h"
 #include "services/perception/geometry/polygon.h"
 #include "services/perception/tracking/patch_matcher.h"
 
@@ -425,6 +427,73 @@ void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat
     if (!used[t]) still_lost.push_back(std::move((*lost)[t]));
   }
   *lost = std::move(still_lost);
+}
+
+int FeatureTracker::SetWarpReferences(const std::vector<std::pair<int64_t, int64_t>>& track_keys) {
+  if (prev_pyramid_.empty() || track_keys.empty()) return 0;
+  const cv::Mat& image = prev_pyramid_[0];  // the latest image
+  std::unordered_map<int64_t, size_t> index_of;
+  for (size_t i = 0; i < tracks_.size(); ++i) index_of[tracks_[i].id] = i;
+  const int side = options_.warp_reference_px;
+  int stored = 0;
+  for (const auto& [id, key] : track_keys) {
+    auto it = index_of.find(id);
+    if (it == index_of.end()) continue;
+    Track& t = tracks_[it->second];
+    if (!t.active() || t.last_seen_frame != frame_index_) continue;
+    const float half = 0.5f * static_cast<float>(side - 1);
+    if (t.uv.x() - half < 0.0f || t.uv.y() - half < 0.0f || t.uv.x() + half > image.cols - 1.0f ||
+        t.uv.y() + half > image.rows - 1.0f) {
+      continue;
+    }
+    cv::getRectSubPix(image, cv::Size(side, side), cv::Point2f(t.uv.x(), t.uv.y()), t.warp_reference, CV_32F);
+    t.warp_reference_uv = t.uv;
+    t.warp_reference_key = key;
+    ++stored;
+  }
+  return stored;
+}
+
+WarpAlignStats FeatureTracker::AlignToReferences(const std::vector<WarpedReference>& warps) {
+  WarpAlignStats out;
+  if (prev_pyramid_.empty() || warps.empty()) return out;
+  const cv::Mat& image = prev_pyramid_[0];  // the latest image
+  std::unordered_map<int64_t, size_t> index_of;
+  for (size_t i = 0; i < tracks_.size(); ++i) index_of[tracks_[i].id] = i;
+  const float max_scale = static_cast<float>(options_.warp_max_scale);
+  const float max_px2 = static_cast<float>(options_.warp_align_max_px * options_.warp_align_max_px);
+  const float border = static_cast<float>(options_.border_px);
+  const float a = static_cast<float>(options_.velocity_smoothing);
+  double correction_sum = 0.0;
+  cv::Mat templ;
+  for (const WarpedReference& w : warps) {
+    auto it = index_of.find(w.track_id);
+    if (it == index_of.end()) continue;
+    Track& t = tracks_[it->second];
+    if (!t.active() || t.last_seen_frame != frame_index_ || t.warp_reference.empty() || !w.cur_from_ref.allFinite()) {
+      continue;
+    }
+    const Eigen::Vector2f sv = SingularValues2x2(w.cur_from_ref);
+    if (!(sv[0] <= max_scale && sv[1] >= 1.0f / max_scale)) continue;
+    // One pixel of border gives the template's gradients.
+    if (!WarpReferencePatch(t.warp_reference, w.cur_from_ref, options_.patch_size + 2, &templ)) continue;
+    ++out.tried;
+    const PatchAlignment al = AlignPatch(image, templ, t.uv);
+    const Eigen::Vector2f shift = al.uv - t.uv;
+    cv::Mat patch;
+    if (!al.converged || al.ncc < options_.warp_align_min_ncc || shift.squaredNorm() > max_px2 ||
+        !InBorder(al.uv, image, border) || !ExtractPatch(image, al.uv, options_.patch_size, &patch)) {
+      ++out.refused;
+      continue;
+    }
+    t.uv = al.uv;
+    t.velocity += (t.age > 2 ? a : 1.0f) * shift;
+    t.patch = patch;
+    ++out.corrected;
+    correction_sum += shift.norm();
+  }
+  if (out.corrected > 0) out.mean_correction_px = correction_sum / out.corrected;
+  return out;
 }
 
 int64_t FeatureTracker::AdoptTrack(const Eigen::Vector2f& uv, int body_id) {

@@ -4,9 +4,10 @@
 // Feature tracking of thesis chapter 2: FAST corners spread over the image by a grid,
 // new features every frame, pyramidal KLT with forward-backward and unicity checks,
 // two-stage matching (wide search first so that movers survive, then guided matching
-// of lost / occluded tracks around positions predicted by the bodies' motion), and
+// of lost / occluded tracks around positions predicted by the bodies' motion),
 // occlusion by moving objects' hulls (occluded tracks are kept, not matched, until
-// they reappear).
+// they reappear), and affine patch warps when the pose is known (tracks re-aligned on
+// their reference appearance warped into the new view, against KLT's drift).
 
 #include <cstdint>
 #include <unordered_map>
@@ -50,6 +51,19 @@ struct TrackerOptions {
   double velocity_smoothing = 0.5;     // weight of the newest flow in the velocity estimate
   double min_patch_ncc = 0.6;          // appearance check of every KLT match against the track's template (NCC)
   double min_anchor_ncc = 0.4;         // ... and against its first appearance: catches tracks dragged along occlusion boundaries (NCC)
+  // Affine patch warps when the pose is known (thesis sec. 2.2): frame-to-frame KLT
+  // drifts under strong perspective change (ground tracks near the camera: 5-20 px over
+  // 40-70 images in sim-following). Tracks of known 3D position are re-aligned on their
+  // reference appearance warped into the current view (SetWarpReferences /
+  // AlignToReferences; the caller supplies the warps).
+  bool warp_align = true;              // the perception loop re-aligns static map tracks on warped references
+  int warp_align_every = 1;            // each track is re-aligned every this many images (staggered by id)
+  int warp_reference_px = 31;          // side of the stored reference patch, odd (px)
+  double warp_align_max_px = 0.5;      // larger corrections are not taken: tracks are re-aligned every image, so a correction absorbs one image's drift (px)
+  double warp_align_min_ncc = 0.8;     // the warped reference must match this well after alignment (NCC)
+  double warp_max_scale = 2.0;         // warps that scale a patch by more than this (either way) are not used
+  double warp_rereference_scale = 1.4; // ... by more than this: the track takes a new reference at the next keyframe
+  double warp_ground_band = 0.1;       // points this close to the ground plane (share of the camera's height) take its normal
   bool descriptor_fallback = true;     // when KLT keeps too few tracks (low frame rate, wide baseline), match ORB descriptors
   double fallback_survival = 0.5;      // KLT survival share below which the fallback runs
   int fallback_features = 1500;        // ORB features detected for the fallback (count)
@@ -89,6 +103,13 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION(velocity_smoothing > 0.0 && velocity_smoothing <= 1.0);
     MBSLAM_CHECK_OPTION(min_patch_ncc >= -1.0 && min_patch_ncc < 1.0);
     MBSLAM_CHECK_OPTION(min_anchor_ncc >= -1.0 && min_anchor_ncc < 1.0);
+    MBSLAM_CHECK_OPTION_GE(warp_align_every, 1);
+    MBSLAM_CHECK_OPTION(warp_reference_px >= patch_size + 2 && warp_reference_px % 2 == 1);
+    MBSLAM_CHECK_OPTION_GT(warp_align_max_px, 0.0);
+    MBSLAM_CHECK_OPTION(warp_align_min_ncc >= -1.0 && warp_align_min_ncc < 1.0);
+    MBSLAM_CHECK_OPTION_GE(warp_max_scale, 1.0);
+    MBSLAM_CHECK_OPTION(warp_rereference_scale >= 1.0 && warp_rereference_scale <= warp_max_scale);
+    MBSLAM_CHECK_OPTION_GE(warp_ground_band, 0.0);
     MBSLAM_CHECK_OPTION(fallback_survival >= 0.0 && fallback_survival <= 1.0);
     MBSLAM_CHECK_OPTION_GT(fallback_features, 0);
     MBSLAM_CHECK_OPTION(fallback_max_hamming > 0 && fallback_max_hamming <= 256);
@@ -125,6 +146,16 @@ struct TrackerOptions {
     v("velocity_smoothing", &velocity_smoothing, "weight of the newest flow in track velocity (0..1]");
     v("min_patch_ncc", &min_patch_ncc, "appearance check of KLT matches against the template (NCC)");
     v("min_anchor_ncc", &min_anchor_ncc, "appearance check against the first observation (NCC)");
+    v("warp_align", &warp_align, "static map tracks re-aligned on their keyframe appearance warped by the known pose");
+    v("warp_align_every", &warp_align_every, "each track re-aligned every this many images, staggered by id (count)");
+    v("warp_reference_px", &warp_reference_px, "side of the reference patch for affine warps, odd (px)");
+    v("warp_align_max_px", &warp_align_max_px, "largest correction by alignment on the warped reference (px)");
+    v("warp_align_min_ncc", &warp_align_min_ncc, "the warped reference must match this well after alignment (NCC)");
+    v("warp_max_scale", &warp_max_scale, "warps scaling a patch by more than this either way are not used");
+    v("warp_rereference_scale", &warp_rereference_scale,
+      "warps scaling by more than this: new reference at the next keyframe");
+    v("warp_ground_band", &warp_ground_band,
+      "points this close to the ground plane (share of the camera height) take its normal for the warp");
     v("descriptor_fallback", &descriptor_fallback, "ORB matching when KLT keeps too few tracks");
     v("fallback_survival", &fallback_survival, "KLT survival share that triggers the fallback");
     v("fallback_features", &fallback_features, "ORB features for the fallback (count)");
@@ -148,6 +179,20 @@ struct TrackingHints {
     std::vector<Eigen::Vector2f> points;
   };
   std::vector<Hull> occluders;
+};
+
+// A track's reference appearance warped into the latest image: `cur_from_ref` maps
+// pixel offsets around the track in its reference view to offsets in the latest image.
+struct WarpedReference {
+  int64_t track_id = 0;
+  Eigen::Matrix2f cur_from_ref = Eigen::Matrix2f::Identity();
+};
+
+struct WarpAlignStats {
+  int tried = 0;       // tracks with a usable reference and warp
+  int corrected = 0;   // moved by the alignment
+  int refused = 0;     // alignment failed, moved too far or matched badly: left as KLT had it
+  double mean_correction_px = 0.0;  // over the corrected ones (px)
 };
 
 struct TrackerStats {
@@ -182,6 +227,17 @@ class FeatureTracker {
   // in the latest image; returns its id, or -1 if it is too close to an existing track
   // or to the border.
   int64_t AdoptTrack(const Eigen::Vector2f& uv, int body_id);
+
+  // Stores the reference appearance for affine warps of the given tracks (track id,
+  // caller's key) at their positions in the latest image. Tracks not observed in the
+  // latest image are skipped. Returns the number stored.
+  int SetWarpReferences(const std::vector<std::pair<int64_t, int64_t>>& track_keys);
+
+  // Re-aligns tracks observed in the latest image on their reference appearance warped
+  // into it: the KLT position moves to the aligned one when the correction is at most
+  // warp_align_max_px and the warped reference matches (warp_align_min_ncc). Warps
+  // scaling by more than warp_max_scale are skipped (the caller should re-reference).
+  WarpAlignStats AlignToReferences(const std::vector<WarpedReference>& warps);
 
   std::vector<Track>& tracks() { return tracks_; }
   const std::vector<Track>& tracks() const { return tracks_; }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 
 #include <opencv2/imgproc.hpp>
@@ -230,6 +231,139 @@ TEST(PatchMatcher, FindsShiftedPatch) {
   const PatchMatch m = FindPatchZssd(moved, patch, {101.0f, 90.0f}, 8);
   ASSERT_TRUE(m.found);
   EXPECT_LT((m.uv - Eigen::Vector2f(103.4f, 88.4f)).norm(), 0.35);
+}
+
+}  // namespace
+}  // namespace mbslam
+
+namespace mbslam {
+namespace {
+
+// image2(c + A (x - c)) = image1(x): an affine view change about c.
+cv::Mat AffineView(const cv::Mat& img, const Eigen::Matrix2f& A, const Eigen::Vector2f& c) {
+  const Eigen::Vector2f t = c - A * c;
+  cv::Mat m = (cv::Mat_<double>(2, 3) << A(0, 0), A(0, 1), t.x(), A(1, 0), A(1, 1), t.y());
+  cv::Mat out;
+  cv::warpAffine(img, out, m, img.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  return out;
+}
+
+TEST(PatchMatcher, AlignPatchFindsSubpixelShiftWithGainAndBias) {
+  const cv::Mat img = Texture(200, 200, 5);
+  cv::Mat templ;
+  cv::getRectSubPix(img, cv::Size(13, 13), cv::Point2f(100.3f, 90.6f), templ, CV_32F);
+  templ = templ * 0.7 + 20.0;  // another exposure
+  const PatchAlignment al = AlignPatch(img, templ, Eigen::Vector2f(101.5f, 89.5f));
+  ASSERT_TRUE(al.converged);
+  EXPECT_LT((al.uv - Eigen::Vector2f(100.3f, 90.6f)).norm(), 0.03f);
+  EXPECT_GT(al.ncc, 0.99f);
+  // A flat template cannot be aligned.
+  const PatchAlignment flat = AlignPatch(img, cv::Mat(13, 13, CV_32F, cv::Scalar(50.0f)), Eigen::Vector2f(100, 90));
+  EXPECT_FALSE(flat.converged);
+}
+
+float FloatNcc(const cv::Mat& a, const cv::Mat& b) {
+  cv::Mat r;
+  cv::matchTemplate(a, b, r, cv::TM_CCOEFF_NORMED);
+  return r.at<float>(0, 0);
+}
+
+TEST(PatchMatcher, WarpedReferenceMatchesTheNewView) {
+  const cv::Mat img = Texture(320, 320, 6);
+  const Eigen::Matrix2f A = (Eigen::Matrix2f() << 1.3f, 0.1f, -0.05f, 1.7f).finished();
+  const Eigen::Vector2f c(160.0f, 160.0f);
+  const cv::Mat view = AffineView(img, A, c);
+  const Eigen::Vector2f p(150.0f, 170.0f);
+  const Eigen::Vector2f q = c + A * (p - c);
+  cv::Mat reference, templ, seen;
+  cv::getRectSubPix(img, cv::Size(31, 31), cv::Point2f(p.x(), p.y()), reference, CV_32F);
+  ASSERT_TRUE(WarpReferencePatch(reference, A, 13, &templ));
+  cv::getRectSubPix(view, cv::Size(13, 13), cv::Point2f(q.x(), q.y()), seen, CV_32F);
+  const cv::Mat unwarped = reference(cv::Rect(9, 9, 13, 13)).clone();
+  EXPECT_GT(FloatNcc(seen, templ), 0.98f);
+  EXPECT_LT(FloatNcc(seen, unwarped), FloatNcc(seen, templ) - 0.1f);
+  // A shrinking view needs samples beyond the reference: refused.
+  EXPECT_FALSE(WarpReferencePatch(reference, 0.3f * Eigen::Matrix2f::Identity(), 13, &templ));
+}
+
+TEST(FeatureTracker, DriftedTracksAreRealignedOnTheirWarpedReference) {
+  TrackerOptions o;
+  o.max_features = 300;
+  o.warp_align_max_px = 2.0;  // the drift below is 1.2 px
+  FeatureTracker tracker(o);
+  const cv::Mat img = Texture(640, 480, 7);
+  tracker.TrackFrame(Pyramid(img), 0, {});
+  std::vector<std::pair<int64_t, int64_t>> keys;
+  std::map<int64_t, Eigen::Vector2f> first;
+  for (const Track& t : tracker.tracks()) {
+    keys.emplace_back(t.id, 42);
+    first[t.id] = t.uv;
+  }
+  EXPECT_GT(tracker.SetWarpReferences(keys), static_cast<int>(keys.size()) * 9 / 10) << "nearly all away from the border";
+  // The next view: a ground-like stretch, twice as strong vertically.
+  const Eigen::Matrix2f A = (Eigen::Matrix2f() << 1.2f, 0.0f, 0.05f, 1.45f).finished();
+  const Eigen::Vector2f c(320.0f, 240.0f);
+  TrackingHints hints;
+  for (const auto& [id, uv] : first) hints.predicted_uv[id] = c + A * (uv - c);
+  tracker.TrackFrame(Pyramid(AffineView(img, A, c)), 1, hints);
+  // Drift every surviving old track by 1.2 px, then re-align with the true warp and, for
+  // contrast, with no warp at all.
+  const Eigen::Vector2f drift(0.9f, -0.8f);
+  std::vector<WarpedReference> warps, none;
+  std::map<int64_t, Eigen::Vector2f> truth;
+  for (Track& t : tracker.tracks()) {
+    auto it = first.find(t.id);
+    if (it == first.end() || !t.active() || t.last_seen_frame != 1) continue;
+    truth[t.id] = c + A * (it->second - c);
+    t.uv = truth[t.id] + drift;
+    warps.push_back({t.id, A});
+    none.push_back({t.id, Eigen::Matrix2f::Identity()});
+  }
+  ASSERT_GT(truth.size(), 100u);
+  std::vector<Track> saved = tracker.tracks();
+  const WarpAlignStats stats = tracker.AlignToReferences(warps);
+  EXPECT_GE(stats.tried, static_cast<int>(truth.size()) * 95 / 100);
+  EXPECT_GT(stats.corrected, 0.9 * stats.tried);
+  EXPECT_NEAR(stats.mean_correction_px, drift.norm(), 0.1);
+  auto error_quantile = [&](double q) {
+    std::vector<float> errors;
+    for (const Track& t : tracker.tracks()) {
+      if (truth.count(t.id)) errors.push_back((t.uv - truth[t.id]).norm());
+    }
+    std::sort(errors.begin(), errors.end());
+    return errors[static_cast<size_t>(q * static_cast<double>(errors.size() - 1))];
+  };
+  const float warped_median = error_quantile(0.5);
+  EXPECT_LT(warped_median, 0.05f);
+  EXPECT_LT(error_quantile(0.9), 0.15f);
+  // Without the warp the reference does not fit the stretched view: the alignment lands
+  // off the true position.
+  tracker.tracks() = saved;
+  tracker.AlignToReferences(none);
+  EXPECT_GT(error_quantile(0.5), 3.0f * warped_median);
+  // Corrections beyond warp_align_max_px are refused.
+  TrackerOptions strict = o;
+  strict.warp_align_max_px = 0.5;
+  FeatureTracker strict_tracker(strict);
+  strict_tracker.TrackFrame(Pyramid(img), 0, {});
+  strict_tracker.SetWarpReferences(keys);
+  strict_tracker.TrackFrame(Pyramid(AffineView(img, A, c)), 1, hints);
+  std::vector<WarpedReference> strict_warps;
+  for (Track& t : strict_tracker.tracks()) {
+    auto it = first.find(t.id);
+    if (it == first.end() || !t.active() || t.last_seen_frame != 1) continue;
+    t.uv = c + A * (it->second - c) + drift;
+    strict_warps.push_back({t.id, A});
+  }
+  const WarpAlignStats strict_stats = strict_tracker.AlignToReferences(strict_warps);
+  EXPECT_GT(strict_stats.tried, 100);
+  EXPECT_EQ(strict_stats.corrected, 0);
+  EXPECT_EQ(strict_stats.refused, strict_stats.tried);
+  // A warp beyond warp_max_scale is not used.
+  tracker.tracks() = saved;
+  std::vector<WarpedReference> huge;
+  for (const WarpedReference& w : warps) huge.push_back({w.track_id, 3.0f * Eigen::Matrix2f::Identity()});
+  EXPECT_EQ(tracker.AlignToReferences(huge).tried, 0);
 }
 
 }  // namespace

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
+
+#include <Eigen/LU>
 
 #include <opencv2/imgproc.hpp>
 
@@ -111,6 +114,153 @@ PatchMatch FindPatchZssd(const cv::Mat& image, const cv::Mat& patch,
   best.second = second;
   best.found = true;
   return best;
+}
+
+namespace {
+
+// Bilinear sample of a CV_32F image; the caller keeps (x, y) within
+// [0, cols - 1] x [0, rows - 1].
+float Bilinear(const cv::Mat& image, float x, float y) {
+  const int x0 = std::min(static_cast<int>(x), image.cols - 2);
+  const int y0 = std::min(static_cast<int>(y), image.rows - 2);
+  const float ax = x - static_cast<float>(x0), ay = y - static_cast<float>(y0);
+  const float* r0 = image.ptr<float>(y0);
+  const float* r1 = image.ptr<float>(y0 + 1);
+  return (1.0f - ay) * ((1.0f - ax) * r0[x0] + ax * r0[x0 + 1]) + ay * ((1.0f - ax) * r1[x0] + ax * r1[x0 + 1]);
+}
+
+}  // namespace
+
+bool WarpReferencePatch(const cv::Mat& reference, const Eigen::Matrix2f& cur_from_ref, int side, cv::Mat* templ) {
+  if (reference.empty() || reference.type() != CV_32F || reference.rows != reference.cols || side < 3) return false;
+  const float det = cur_from_ref.determinant();
+  if (!std::isfinite(det) || std::abs(det) < 1e-6f) return false;
+  const Eigen::Matrix2f ref_from_cur = cur_from_ref.inverse();
+  const float centre = 0.5f * static_cast<float>(reference.cols - 1);
+  const float half = 0.5f * static_cast<float>(side - 1);
+  // The patch's corners bound every sample (the warp is linear).
+  const float reach = (ref_from_cur.cwiseAbs() * Eigen::Vector2f(half, half)).maxCoeff();
+  if (!(reach <= centre)) return false;
+  templ->create(side, side, CV_32F);
+  const Eigen::Vector2f step_x = ref_from_cur.col(0);
+  for (int y = 0; y < side; ++y) {
+    float* row = templ->ptr<float>(y);
+    Eigen::Vector2f p = Eigen::Vector2f::Constant(centre) + ref_from_cur * Eigen::Vector2f(-half, static_cast<float>(y) - half);
+    for (int x = 0; x < side; ++x, p += step_x) row[x] = Bilinear(reference, p.x(), p.y());
+  }
+  return true;
+}
+
+PatchAlignment AlignPatch(const cv::Mat& image, const cv::Mat& templ, const Eigen::Vector2f& start,
+                          int max_iterations, float tolerance_px) {
+  PatchAlignment out;
+  out.uv = start;
+  const int n = templ.rows;
+  if (templ.empty() || templ.type() != CV_32F || templ.cols != n || n < 5 || n % 2 == 0 || image.type() != CV_8U) {
+    return out;
+  }
+  const int inner = n - 2;
+  const int m = inner * inner;
+  const float half = 0.5f * static_cast<float>(inner - 1);
+  // Template values and gradients on the inner pixels, zero-mean (the bias is free, so the
+  // mean gradient carries no information).
+  std::vector<float> t(static_cast<size_t>(m)), tx(static_cast<size_t>(m)), ty(static_cast<size_t>(m));
+  double tmean = 0.0, gxm = 0.0, gym = 0.0;
+  for (int y = 1, k = 0; y < n - 1; ++y) {
+    const float* r = templ.ptr<float>(y);
+    const float* ru = templ.ptr<float>(y - 1);
+    const float* rd = templ.ptr<float>(y + 1);
+    for (int x = 1; x < n - 1; ++x, ++k) {
+      t[k] = r[x];
+      tx[k] = 0.5f * (r[x + 1] - r[x - 1]);
+      ty[k] = 0.5f * (rd[x] - ru[x]);
+      tmean += t[k];
+      gxm += tx[k];
+      gym += ty[k];
+    }
+  }
+  tmean /= m;
+  gxm /= m;
+  gym /= m;
+  double a = 0.0, b = 0.0, c = 0.0, tvar = 0.0;
+  for (int k = 0; k < m; ++k) {
+    t[k] -= static_cast<float>(tmean);
+    tx[k] -= static_cast<float>(gxm);
+    ty[k] -= static_cast<float>(gym);
+    a += tx[k] * tx[k];
+    b += tx[k] * ty[k];
+    c += ty[k] * ty[k];
+    tvar += t[k] * t[k];
+  }
+  const double det = a * c - b * b;
+  if (!(a + c > 1.0) || !(det > 1e-6 * (a + c) * (a + c)) || !(tvar > 1e-6 * m)) return out;
+
+  std::vector<float> w(static_cast<size_t>(m));
+  // Samples the image under the template at `p`; the image's gain-normalised difference
+  // from the template is returned through `ncc` and `w`.
+  auto sample = [&](const Eigen::Vector2f& p, double* wvar_out) -> bool {
+    if (!(p.x() - half >= 0.0f && p.y() - half >= 0.0f && p.x() + half <= image.cols - 1.0f &&
+          p.y() + half <= image.rows - 1.0f)) {
+      return false;
+    }
+    // A translated patch: every sample has the same bilinear weights.
+    const float left = p.x() - half, top = p.y() - half;
+    const int x0 = std::min(static_cast<int>(left), image.cols - 1 - inner);
+    const int y0 = std::min(static_cast<int>(top), image.rows - 1 - inner);
+    const float ax = left - static_cast<float>(x0), ay = top - static_cast<float>(y0);
+    const float w00 = (1.0f - ay) * (1.0f - ax), w01 = (1.0f - ay) * ax, w10 = ay * (1.0f - ax), w11 = ay * ax;
+    double wmean = 0.0;
+    for (int y = 0, k = 0; y < inner; ++y) {
+      const uint8_t* r0 = image.ptr<uint8_t>(y0 + y) + x0;
+      const uint8_t* r1 = image.ptr<uint8_t>(y0 + y + 1) + x0;
+      float row_sum = 0.0f;
+      for (int x = 0; x < inner; ++x, ++k) {
+        w[k] = w00 * r0[x] + w01 * r0[x + 1] + w10 * r1[x] + w11 * r1[x + 1];
+        row_sum += w[k];
+      }
+      wmean += row_sum;
+    }
+    wmean /= m;
+    double wvar = 0.0;
+    for (int k = 0; k < m; ++k) {
+      w[k] -= static_cast<float>(wmean);
+      wvar += static_cast<double>(w[k]) * w[k];
+    }
+    *wvar_out = wvar;
+    return wvar > 1e-6 * m;
+  };
+  Eigen::Vector2f p = start;
+  for (int it = 0; it < max_iterations; ++it) {
+    double wvar = 0.0;
+    if (!sample(p, &wvar)) return out;
+    // The image's contrast scaled to the template's (gain), then the Gauss-Newton step of
+    // the template's shift; the image position moves the opposite way.
+    const float gain = static_cast<float>(std::sqrt(tvar / wvar));
+    double bx = 0.0, by = 0.0;
+    for (int k = 0; k < m; ++k) {
+      const float e = gain * w[k] - t[k];
+      bx += tx[k] * e;
+      by += ty[k] * e;
+    }
+    const Eigen::Vector2f step(static_cast<float>((c * bx - b * by) / det), static_cast<float>((a * by - b * bx) / det));
+    if (!step.allFinite()) return out;
+    p -= step;
+    out.iterations = it + 1;
+    if (step.squaredNorm() < tolerance_px * tolerance_px) {
+      out.converged = true;
+      break;
+    }
+  }
+  double wvar = 0.0;
+  if (!sample(p, &wvar)) {
+    out.converged = false;
+    return out;
+  }
+  double cross = 0.0;
+  for (int k = 0; k < m; ++k) cross += static_cast<double>(w[k]) * t[k];
+  out.ncc = static_cast<float>(cross / std::sqrt(wvar * tvar));
+  out.uv = p;
+  return out;
 }
 
 }  // namespace mbslam

@@ -27,6 +27,26 @@ struct PatchMatch {
 PatchMatch FindPatchZssd(const cv::Mat& image, const cv::Mat& patch, const Eigen::Vector2f& predicted,
                          int radius);
 
+// Affine patch warps (thesis sec. 2.2). `reference` is a float (CV_32F) square patch
+// of odd side centred on a feature in a reference image; `cur_from_ref` maps pixel
+// offsets around the feature in that image to offsets in the current image. Fills
+// `templ` (CV_32F, side x side) with the reference's appearance as the current image
+// should show it. False when the warp is singular or needs samples outside `reference`.
+bool WarpReferencePatch(const cv::Mat& reference, const Eigen::Matrix2f& cur_from_ref, int side, cv::Mat* templ);
+
+struct PatchAlignment {
+  Eigen::Vector2f uv = Eigen::Vector2f::Zero();  // aligned position (px)
+  float ncc = 0.0f;       // normalised cross-correlation there (inner pixels)
+  int iterations = 0;
+  bool converged = false;  // the last step was below the tolerance
+};
+
+// Translational Lucas-Kanade (inverse compositional) of a float template (CV_32F, odd
+// side n >= 5) in an 8-bit image from `start`, the template's gain and bias free; the
+// n-2 inner pixels are compared (the border gives the template's gradients).
+PatchAlignment AlignPatch(const cv::Mat& image, const cv::Mat& templ, const Eigen::Vector2f& start,
+                          int max_iterations = 10, float tolerance_px = 0.01f);
+
 }  // namespace mbslam
 
 #endif  // MBSLAM_SERVICES_PERCEPTION_TRACKING_PATCH_MATCHER_H_

@@ -28,6 +28,12 @@ struct Track {
   float match_error = 0.0f;        // forward-backward error of the last match (px)
   cv::Mat patch;                   // template at the last observation (ZSSD re-detection)
   cv::Mat anchor;                  // template at the first observation (drift check)
+  // Reference appearance for affine patch warps (FeatureTracker::SetWarpReferences): a
+  // larger float patch, its position, and the caller's key of that view (the perception
+  // loop uses its keyframe's image index; -1 none).
+  cv::Mat warp_reference;
+  Eigen::Vector2f warp_reference_uv = Eigen::Vector2f::Constant(NAN);
+  int64_t warp_reference_key = -1;
   // Set by segmentation / SLAM (fed back to the tracker):
   int body_id = -1;                // 0 static world, > 0 object, -1 unassigned
   float p_static = 0.5f;           // P(static w.r.t. the static world)
