@@ -174,9 +174,12 @@ void PerceptionCore::AlignOnWarpedReferences(const Rigid3d& cam_from_world, cons
   std::optional<double> camera_height;
   if (ground_) camera_height = ground_->Height(cam_from_world.Inverse().translation);
   const double max_scale = options_.tracking.warp_max_scale;
+  // Static as SLAM sees it: without segmentation feedback (the ablation) every map
+  // track is.
+  const bool use_labels = options_.slam.use_segmentation;
   std::vector<WarpedReference> warps;
   for (const Track& t : tracker_.tracks()) {
-    if (!t.active() || t.last_seen_frame != frame_index_ || t.body_id != 0) continue;
+    if (!t.active() || t.last_seen_frame != frame_index_ || (use_labels && t.body_id != 0)) continue;
     if ((t.id + frame_index_) % options_.tracking.warp_align_every != 0) continue;
     const int64_t pid = map.PointOfTrack(t.id);
     const MapPoint* point = pid >= 0 ? map.point(pid) : nullptr;
@@ -227,8 +230,9 @@ void PerceptionCore::SetWarpReferences() {
   const Keyframe* kf = slam_.map().LastKeyframe();
   if (kf == nullptr || kf->frame_index != frame_index_) return;
   std::vector<std::pair<int64_t, int64_t>> keys;
+  const bool use_labels = options_.slam.use_segmentation;  // as in AlignOnWarpedReferences
   for (const Track& t : tracker_.tracks()) {
-    if (!t.active() || t.last_seen_frame != frame_index_ || t.body_id != 0) continue;
+    if (!t.active() || t.last_seen_frame != frame_index_ || (use_labels && t.body_id != 0)) continue;
     if (t.warp_reference_key >= 0 && !rereference_tracks_.count(t.id)) continue;
     if (slam_.map().PointOfTrack(t.id) < 0) continue;
     keys.emplace_back(t.id, kf->frame_index);
