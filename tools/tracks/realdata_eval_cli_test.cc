@@ -13,6 +13,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -199,6 +201,31 @@ TEST_F(RealDataCli, CamVidKnownAnswers) {
   EXPECT_DOUBLE_EQ(Get(j, "movable_features_labelled_moving"), 0.75);
   EXPECT_DOUBLE_EQ(Get(j, "moving_features"), 4);
   EXPECT_DOUBLE_EQ(Get(j, "frames"), 2);
+
+  // The diagnostic dump: one line per scored feature with its truth class and its
+  // distance to the nearest car / pedestrian / cyclist pixel (exact Euclidean, px).
+  ASSERT_EQ(RunCli("camvid --root " + (dir_ / "camvid").string() + " --run " + (dir_ / "out.lcmlog").string() +
+                       " --dump " + (dir_ / "features.csv").string(),
+                   &j),
+            0);
+  std::ifstream dump(dir_ / "features.csv");
+  std::string header, line;
+  ASSERT_TRUE(std::getline(dump, header));
+  EXPECT_EQ(header.substr(header.rfind(',') + 1), "truth_dist_px");
+  std::map<std::string, std::string> dist_of;  // "frame,id" -> truth_dist_px
+  int lines = 0;
+  while (std::getline(dump, line)) {
+    ++lines;
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    ASSERT_EQ(cells.size(), 15u) << line;
+    dist_of[cells[1] + "," + cells[2]] = cells.back();
+  }
+  EXPECT_EQ(lines, 10);
+  EXPECT_NEAR(std::stod(dist_of["0,1"]), 30.0, 1e-3);  // (10, 10): the car starts at x = 40
+  EXPECT_NEAR(std::stod(dist_of["0,2"]), 0.0, 1e-9);   // on the car
+  EXPECT_NEAR(std::stod(dist_of["1,7"]), 30.0, 1e-3);
 }
 
 // ---------------------------------------------------------------- shared data (oracles)

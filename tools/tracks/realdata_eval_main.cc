@@ -63,17 +63,25 @@ void WriteOverlay(const std::string& image_path, const cv::Mat& truth, const eva
   cv::imwrite(out_path, img);
 }
 
-// Diagnostics: one CSV line per scored feature.
-void DumpFeatures(std::ofstream& out, const std::string& seq, const eval::PerceptionFrame& f, const cv::Mat& truth) {
+// Diagnostics: one CSV line per scored feature. `positive` marks the truth's positive
+// pixels (DAVIS: the mask; CamVid: cars, pedestrians, cyclists): truth_dist_px is the
+// feature's distance to the nearest one (0 on it).
+void DumpFeatures(std::ofstream& out, const std::string& seq, const eval::PerceptionFrame& f, const cv::Mat& truth,
+                  const cv::Mat& positive) {
+  cv::Mat dist;
+  if (cv::countNonZero(positive) > 0) cv::distanceTransform(positive == 0, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   for (const auto& t : f.tracks) {
     const int x = static_cast<int>(std::lround(t.u)), y = static_cast<int>(std::lround(t.v));
-    const int label = (x >= 0 && y >= 0 && x < truth.cols && y < truth.rows) ? truth.at<uint8_t>(y, x) : -1;
+    const bool inside = x >= 0 && y >= 0 && x < truth.cols && y < truth.rows;
+    const int label = inside ? truth.at<uint8_t>(y, x) : -1;
+    const double d = inside && !dist.empty() ? dist.at<float>(y, x) : -1.0;
     out << seq << ',' << f.frame_seq << ',' << t.id << ',' << t.u << ',' << t.v << ',' << t.prev_u << ','
         << t.prev_v << ',' << t.body_id << ',' << label << ',' << t.p_static << ',' << t.epipolar_px << ','
-        << t.fvb << ',' << t.age << ',' << static_cast<int>(t.flags) << '\n';
+        << t.fvb << ',' << t.age << ',' << static_cast<int>(t.flags) << ',' << d << '\n';
   }
 }
-constexpr const char* kDumpHeader = "sequence,frame,id,u,v,prev_u,prev_v,body_id,truth,p_static,epipolar_px,fvb,age,flags\n";
+constexpr const char* kDumpHeader =
+    "sequence,frame,id,u,v,prev_u,prev_v,body_id,truth,p_static,epipolar_px,fvb,age,flags,truth_dist_px\n";
 
 int Usage() {
   std::fprintf(stderr,
@@ -159,7 +167,7 @@ int RunDavis(const std::map<std::string, std::string>& args) {
         if (!eval::LoadBinaryMask(seq.masks[i], &mask).ok()) continue;
         auto it = run.find(static_cast<int64_t>(i));
         const eval::PerceptionFrame* f = it == run.end() ? nullptr : &it->second;
-        if (dump.is_open() && f) DumpFeatures(dump, seq.name, *f, mask);
+        if (dump.is_open() && f) DumpFeatures(dump, seq.name, *f, mask, mask);
         if (!overlay_dir.empty() && i % overlay_every == 0) {
           char name[32];
           std::snprintf(name, sizeof(name), "%05zu.png", i);
@@ -295,14 +303,14 @@ int RunCamVid(const std::map<std::string, std::string>& args) {
       if (labels.empty()) continue;
       auto it = run.find(static_cast<int64_t>(i));
       const eval::PerceptionFrame* f = it == run.end() ? nullptr : &it->second;
-      if (dump.is_open() && f) DumpFeatures(dump, "camvid", *f, labels);
-      if (!overlay_dir.empty() && i % every == 0) {
-        cv::Mat movable(labels.size(), CV_8UC1, cv::Scalar(0));
-        for (int y = 0; y < labels.rows; ++y) {
-          for (int x = 0; x < labels.cols; ++x) {
-            if (eval::IsCamVidMovableClass(labels.at<uint8_t>(y, x))) movable.at<uint8_t>(y, x) = 255;
-          }
+      cv::Mat movable(labels.size(), CV_8UC1, cv::Scalar(0));
+      for (int y = 0; y < labels.rows; ++y) {
+        for (int x = 0; x < labels.cols; ++x) {
+          if (eval::IsCamVidMovableClass(labels.at<uint8_t>(y, x))) movable.at<uint8_t>(y, x) = 255;
         }
+      }
+      if (dump.is_open() && f) DumpFeatures(dump, "camvid", *f, labels, movable);
+      if (!overlay_dir.empty() && i % every == 0) {
         char name[32];
         std::snprintf(name, sizeof(name), "%05zu.png", i);
         WriteOverlay(frames[i].image, movable, f, (fs::path(overlay_dir) / name).string());
