@@ -8,8 +8,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "common/lcm/lcm_log.h"
 #include "mbslam/camera_pose_t.hpp"
@@ -206,6 +209,27 @@ TEST_F(EvalCli, ObjectsFromLogs) {
   // past the last truth); every third (0, 3, ..., 21: 8 of them) is off by 1 m.
   EXPECT_EQ(j.Find("volumes_checked")->AsDouble(), 23.0);
   EXPECT_NEAR(j.Find("volume_hit_rate")->AsDouble(), 15.0 / 23.0, 1e-12);
+
+  // --dump: one row per matched sample, truth and estimate in the true camera's frame.
+  const std::string dump = Path("objects.csv");
+  ASSERT_EQ(RunEval("objects --est-log " + path + " --gt-log " + path + " --dump " + dump, &j), 0);
+  std::ifstream in(dump);
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line.rfind("est_id,body,t_s,true_x,true_y,true_z,est_x,est_y,est_z,", 0), 0u) << line;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) v.push_back(cell == "person" ? 0.0 : std::stod(cell));
+    ASSERT_EQ(v.size(), 12u) << line;
+    EXPECT_EQ(v[0], 8.0);
+    for (int k = 3; k < 6; ++k) EXPECT_NEAR(v[k], v[k + 3], 1e-3) << line;  // estimate = truth
+    EXPECT_NEAR(v[9], 0.9, 1e-3);                                           // body height
+    ++rows;
+  }
+  EXPECT_EQ(rows, 30);
 }
 
 }  // namespace

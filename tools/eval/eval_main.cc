@@ -591,6 +591,36 @@ int RunObjects(const Args& args) {
     oj.Set("depth_error_over_time_m", series);
     list.Push(oj);
   }
+  if (args.Has("dump")) {
+    // One row per matched estimate sample: the estimate mapped into the truth world and the
+    // body centre, both in the true camera's frame (x right, y down, z depth; metres), and
+    // their heights above the simulated ground (world z).
+    std::ostringstream csv;
+    csv << "est_id,body,t_s,true_x,true_y,true_z,est_x,est_y,est_z,true_height,est_height,est_ref_depth\n";
+    for (const auto& o : result.objects) {
+      const auto e = objects.find(o.est_id);
+      const auto b = gt.bodies.find(o.gt_id);
+      if (e == objects.end() || b == gt.bodies.end()) continue;
+      for (const auto& s : e->second.samples) {
+        mbslam::Rigid3d body_pose, world_from_cam;
+        if (!eval::InterpolatePose(b->second.poses, s.utime, 20000, &body_pose) ||
+            !eval::InterpolatePose(gt.camera, s.utime, 20000, &world_from_cam)) {
+          continue;
+        }
+        const mbslam::Rigid3d cam_from_world = world_from_cam.Inverse();
+        const Eigen::Vector3d est_world = ate.gt_from_est * s.position;
+        const Eigen::Vector3d t = cam_from_world * body_pose.translation;
+        const Eigen::Vector3d q = cam_from_world * est_world;
+        char line[512];
+        std::snprintf(line, sizeof(line), "%d,%s,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", o.est_id,
+                      o.gt_name.c_str(), static_cast<double>(s.utime - gt.camera.front().utime) * 1e-6, t.x(),
+                      t.y(), t.z(), q.x(), q.y(), q.z(), body_pose.translation.z(), est_world.z(),
+                      s.depth >= 0.0 ? s.depth * ate.gt_from_est.scale : -1.0);
+        csv << line;
+      }
+    }
+    if (Status ws = mbslam::WriteStringAtomically(args.Get("dump"), csv.str()); !ws.ok()) return Fail(ws.message());
+  }
   std::printf("predicted volumes at %lld us: %d of %d contain the true centre (%.3f); median size %.2f x the true box\n",
               static_cast<long long>(options.horizon_us), result.volumes_hit,
               result.volumes_checked, result.hit_rate, result.volume_ratio_median);
@@ -883,6 +913,7 @@ void Usage() {
            --features FILE ("stem u v moving" per line) [--root DIR]
   objects  per-object trajectory / scale / depth errors and predicted-volume hit rate
            --est-log LOG --gt-log LOG [--horizon-us N] [--align sim3|se3] [--max-match-m M] [--settle-us N]
+           [--dump FILE.csv: per matched sample, truth and estimate in the true camera frame]
   reconstructions  moving objects' own reconstructions (result/reconstructions/): camera-relative
            trajectory and shape (point-to-box distance) after a similarity, per body
            --dir DIR --gt-log LOG [--min-samples 10] [--max-dt-us N]
