@@ -173,7 +173,6 @@ void PerceptionCore::AlignOnWarpedReferences(const Rigid3d& cam_from_world, cons
   const double rereference_scale = options_.tracking.warp_rereference_scale;
   std::optional<double> camera_height;
   if (ground_) camera_height = ground_->Height(cam_from_world.Inverse().translation);
-  const double max_scale = options_.tracking.warp_max_scale;
   // Static as SLAM sees it: without segmentation feedback (the ablation) every map
   // track is.
   const bool use_labels = options_.slam.use_segmentation;
@@ -203,8 +202,8 @@ void PerceptionCore::AlignOnWarpedReferences(const Rigid3d& cam_from_world, cons
       continue;
     }
     const Eigen::Vector2d sv = SingularValues2x2(*warp);
+    // (Warps beyond tracking.warp_max_scale are skipped by the tracker itself.)
     if (sv[0] > rereference_scale || sv[1] < 1.0 / rereference_scale) rereference_tracks_.insert(t.id);
-    if (sv[0] > max_scale || sv[1] < 1.0 / max_scale) continue;
     warps.push_back({t.id, warp->cast<float>()});
   }
   const WarpAlignStats stats = tracker_.AlignToReferences(warps);

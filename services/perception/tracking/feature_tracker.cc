@@ -429,11 +429,16 @@ void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat
   *lost = std::move(still_lost);
 }
 
+std::unordered_map<int64_t, size_t> FeatureTracker::IndexById() const {
+  std::unordered_map<int64_t, size_t> index_of;
+  for (size_t i = 0; i < tracks_.size(); ++i) index_of[tracks_[i].id] = i;
+  return index_of;
+}
+
 int FeatureTracker::SetWarpReferences(const std::vector<std::pair<int64_t, int64_t>>& track_keys) {
   if (prev_pyramid_.empty() || track_keys.empty()) return 0;
   const cv::Mat& image = prev_pyramid_[0];  // the latest image
-  std::unordered_map<int64_t, size_t> index_of;
-  for (size_t i = 0; i < tracks_.size(); ++i) index_of[tracks_[i].id] = i;
+  const std::unordered_map<int64_t, size_t> index_of = IndexById();
   const int side = options_.warp_reference_px;
   int stored = 0;
   for (const auto& [id, key] : track_keys) {
@@ -458,8 +463,7 @@ WarpAlignStats FeatureTracker::AlignToReferences(const std::vector<WarpedReferen
   WarpAlignStats out;
   if (prev_pyramid_.empty() || warps.empty()) return out;
   const cv::Mat& image = prev_pyramid_[0];  // the latest image
-  std::unordered_map<int64_t, size_t> index_of;
-  for (size_t i = 0; i < tracks_.size(); ++i) index_of[tracks_[i].id] = i;
+  const std::unordered_map<int64_t, size_t> index_of = IndexById();
   const float max_scale = static_cast<float>(options_.warp_max_scale);
   const float max_px2 = static_cast<float>(options_.warp_align_max_px * options_.warp_align_max_px);
   const float border = static_cast<float>(options_.border_px);

@@ -250,6 +250,7 @@ class FeatureTracker {
  private:
   void DetectNew(const cv::Mat& image, int64_t frame_index);
   void EnforceUnicity();
+  std::unordered_map<int64_t, size_t> IndexById() const;  // track id -> index in tracks_
   // Wide-baseline fallback: lost tracks re-matched by ORB descriptors.
   void MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat& image, int64_t frame_index,
                           std::vector<Track>* lost, std::vector<Track>* next_tracks);
