@@ -6,11 +6,12 @@
 // set), and prints, last, one JSON line with the figures.
 //
 //   mbslam-bot-ablation [--out DIR] [--seeds N] [--camera car|handheld|both] [--wiggle S]
-//                       [--particles N] [--duration S]
+//                       [--particles N] [--duration S] [--noise-in-units]
 //
 // --wiggle scales the camera's departures from a constant velocity (speed changes, bob,
 // sway, small rotations); 0 gives the smooth camera for which bearings alone cannot
-// observe the depth.
+// observe the depth. --noise-in-units holds the filter's process noise in units at every
+// depth (BearingOnlyTrackerOptions::depth_relative_noise = false), for comparison.
 
 #include <sys/stat.h>
 #include <algorithm>
@@ -67,8 +68,9 @@ struct Curves {
   std::vector<double> depth_true;                // [frame] (m), first seed
 };
 
-bool RunScenario(BotSimCamera camera, BotSimTarget target, double wiggle, int seeds, int particles,
-                 double duration, const std::vector<CueSet>& sets, Curves* out) {
+bool RunScenario(BotSimCamera camera, BotSimTarget target, double wiggle, int seeds,
+                 const BearingOnlyTrackerOptions& base_options, double duration,
+                 const std::vector<CueSet>& sets, Curves* out) {
   const size_t n_sets = sets.size();
   out->depth_sigma.assign(n_sets, {});
   out->pos_err_rel_2s.assign(n_sets, 0.0);
@@ -89,8 +91,7 @@ bool RunScenario(BotSimCamera camera, BotSimTarget target, double wiggle, int se
       return false;
     }
     for (size_t k = 0; k < n_sets; ++k) {
-      BearingOnlyTrackerOptions to;
-      to.num_particles = particles;
+      BearingOnlyTrackerOptions to = base_options;
       to.cues = sets[k].cues;
       BotRunResult r;
       if (Status s = RunBotSequence(seq, to, seed, &r); !s.ok()) {
@@ -233,6 +234,7 @@ int Run(int argc, char** argv) {
   std::string camera_name = "both";
   int seeds = 5, particles = 1000;
   double wiggle = 1.0, duration = 3.0;
+  bool noise_in_units = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
@@ -248,11 +250,13 @@ int Run(int argc, char** argv) {
       particles = std::atoi(argv[++i]);
     } else if (a == "--duration" && has_value) {
       duration = std::atof(argv[++i]);
+    } else if (a == "--noise-in-units") {
+      noise_in_units = true;
     } else {
       std::fprintf(
           stderr,
           "usage: mbslam-bot-ablation [--out DIR] [--seeds N] [--camera car|handheld|both] "
-          "[--wiggle S] [--particles N] [--duration S]\n");
+          "[--wiggle S] [--particles N] [--duration S] [--noise-in-units]\n");
       return 2;
     }
   }
@@ -263,6 +267,10 @@ int Run(int argc, char** argv) {
                  "duration >= 2 s, wiggle >= 0, camera car|handheld|both)\n");
     return 2;
   }
+  BearingOnlyTrackerOptions tracker_options;
+  tracker_options.num_particles = particles;
+  // The process noise in units, as before depth-relative noise (for comparison).
+  tracker_options.depth_relative_noise = !noise_in_units;
   std::vector<Scenario> scenarios;
   for (BotSimCamera camera : {BotSimCamera::kCar, BotSimCamera::kHandHeld}) {
     if (camera_name != "both" && camera_name != BotSimCameraName(camera)) continue;
@@ -280,7 +288,8 @@ int Run(int argc, char** argv) {
       "%d seeds, %d particles\n",
       camera_name.c_str(), wiggle, seeds, particles);
   for (Scenario& sc : scenarios) {
-    if (!RunScenario(sc.camera, sc.target, wiggle, seeds, particles, duration, sets, &sc.curves)) {
+    if (!RunScenario(sc.camera, sc.target, wiggle, seeds, tracker_options, duration, sets,
+                     &sc.curves)) {
       return 1;
     }
     PrintTable(sc.key.c_str(), sc.curves, sets, duration);

@@ -303,9 +303,32 @@ void BearingOnlyTracker::RebaseGroundHeights(const std::optional<GroundPlane>& p
   plane_ = plane;
 }
 
+std::vector<double> BearingOnlyTracker::NoiseScales() const {
+  std::vector<double> scales(particles_.size(), 1.0);
+  if (!options_.depth_relative_noise || particles_.empty()) return scales;
+  const Eigen::Matrix3d R_cw = cam_from_world_.RotationMatrix();
+  const double tz = cam_from_world_.translation.z();
+  double sum_w = 0.0, sum_wz = 0.0;
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    const double z = std::max(R_cw.row(2).dot(particles_[i].position) + tz, options_.min_depth);
+    scales[i] = z;
+    const double w = std::exp(particles_[i].log_weight);
+    sum_w += w;
+    sum_wz += w * z;
+  }
+  if (!(sum_w > 0.0) || !(sum_wz > 0.0)) {
+    std::fill(scales.begin(), scales.end(), 1.0);
+    return scales;
+  }
+  const double mean_z = sum_wz / sum_w;
+  for (double& k : scales) k /= mean_z;
+  return scales;
+}
+
 void BearingOnlyTracker::Propagate(double dt, const StepCues& c,
                                    std::vector<double>* truncation_log_weight) {
   truncation_log_weight->assign(particles_.size(), 0.0);
+  const std::vector<double> noise_scale = NoiseScales();
   const double log_violation = std::log(options_.violation_weight);
   const double sq = std::sqrt(std::max(dt, 0.0));
   const double sv = options_.accel_sigma * sq;
@@ -317,6 +340,7 @@ void BearingOnlyTracker::Propagate(double dt, const StepCues& c,
   int violations = 0;
   for (size_t i = 0; i < particles_.size(); ++i) {
     const BotParticle& prior = particles_[i];
+    const double k = noise_scale[i];
     BotParticle candidate = prior;
     bool ok = false;
     int attempts = 0;
@@ -325,11 +349,11 @@ void BearingOnlyTracker::Propagate(double dt, const StepCues& c,
       candidate = prior;
       if (dt > 0.0) {
         // Twist random walk (white-noise acceleration), then the constant-velocity step.
-        Eigen::Vector3d e = sv * Normal3(&rng_);
+        Eigen::Vector3d e = (k * sv) * Normal3(&rng_);
         if (c.ground) e = InPlane(e, n);
         candidate.linear_velocity += e;
-        Eigen::Vector3d jitter = sp * Normal3(&rng_);
-        if (c.ground) jitter = InPlane(jitter, n) + sh * rng_.Normal() * n;
+        Eigen::Vector3d jitter = (k * sp) * Normal3(&rng_);
+        if (c.ground) jitter = InPlane(jitter, n) + (k * sh) * rng_.Normal() * n;
         if (orientation_tracked_) {
           candidate.angular_velocity += sw * Normal3(&rng_);
           const Eigen::Vector3d wdt = candidate.angular_velocity * dt;
@@ -562,18 +586,20 @@ void BearingOnlyTracker::SfmStep(const BotObservation& o, double dt, const StepC
   const double ratio2 = options_.sfm_sigma_ratio * options_.sfm_sigma_ratio;
   const double scale_step = options_.sfm_scale_sigma * std::sqrt(dt);
   const Eigen::Vector3d n = c.plane.normal;
+  const std::vector<double> noise_scale = NoiseScales();
   int violations = 0;
   for (size_t i = 0; i < particles_.size(); ++i) {
     BotParticle& p = particles_[i];
     if (!(p.sfm_scale > 0.0)) continue;
+    const double k2 = noise_scale[i] * noise_scale[i];
     if (scale_step > 0.0) p.sfm_scale *= std::exp(scale_step * rng_.Normal());
     const double s = p.sfm_scale;
     // Predict.
     Eigen::Vector3d position = p.position + p.linear_velocity * dt;
     const double pp =
-        p.kf_pp + 2.0 * dt * p.kf_pv + dt * dt * p.kf_vv + qa2 * dt * dt * dt / 3.0 + qp2 * dt;
-    const double pv = p.kf_pv + dt * p.kf_vv + 0.5 * qa2 * dt * dt;
-    const double vv = p.kf_vv + qa2 * dt;
+        p.kf_pp + 2.0 * dt * p.kf_pv + dt * dt * p.kf_vv + k2 * (qa2 * dt * dt * dt / 3.0 + qp2 * dt);
+    const double pv = p.kf_pv + dt * p.kf_vv + 0.5 * k2 * qa2 * dt * dt;
+    const double vv = p.kf_vv + k2 * qa2 * dt;
     // Update with the SfM-implied position.
     const Eigen::Vector3d measured = world_from_cam * (s * q);
     const double r = ratio2 * (s * q.z()) * (s * q.z());
@@ -633,7 +659,9 @@ void BearingOnlyTracker::RecordSfm(const BotObservation& o) {
   const Eigen::Matrix3d R_cw = o.cam_from_world.RotationMatrix();
   const Eigen::Vector3d t_cw = o.cam_from_world.translation;
   const double velocity_var = options_.accel_sigma * options_.accel_sigma * 1.0;  // 1 s of it
-  for (BotParticle& p : particles_) {
+  const std::vector<double> noise_scale = NoiseScales();
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    BotParticle& p = particles_[i];
     p.rotation = now.world_from_obj_rotation;
     if (ref != nullptr) p.angular_velocity = w;
     if (!new_map && p.sfm_scale > 0.0) continue;
@@ -644,7 +672,7 @@ void BearingOnlyTracker::RecordSfm(const BotObservation& o) {
     p.sfm_scale = z / q.z();
     p.kf_pp = options_.sfm_sigma_ratio * options_.sfm_sigma_ratio * z * z;
     p.kf_pv = 0.0;
-    p.kf_vv = velocity_var;
+    p.kf_vv = velocity_var * noise_scale[i] * noise_scale[i];
   }
   orientation_tracked_ = true;
   sfm_history_.push_back(now);

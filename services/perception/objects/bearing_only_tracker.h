@@ -15,7 +15,10 @@
 // takes a random-walk step e ~ N(0, diag(accel_sigma^2, angular_accel_sigma^2) dt) before
 // it is applied (white-noise acceleration: frame-rate independent; the twist carried on
 // is the one the thesis recovers as log(g(t+1) g(t)^-1) / dt), and a ~ N(0,
-// diag(position_sigma^2, rotation_sigma^2) dt) jitters the pose.
+// diag(position_sigma^2, rotation_sigma^2) dt) jitters the pose. With depth_relative_noise
+// the translational sigmas hold at the cloud's mean camera depth and scale with each
+// particle's depth, so that bearings alone (whose jitter is sigma / depth) do not tell
+// depth hypotheses apart; only the camera's parallax and the cues do.
 //
 // Measurement (eq. 5.2): z_i = project(cam_from_world * translation(g_i)) in normalised
 // image coordinates; log-weight -|z - z_i|^2 / (2 eta^2), eta = bearing_sigma_px / focal.
@@ -118,6 +121,12 @@ struct BearingOnlyTrackerOptions {
   double angular_accel_sigma = 0.1;  // white-noise angular acceleration (rad/s^1.5)
   double position_sigma = 0.03;      // pose jitter, translation (units/s^0.5)
   double rotation_sigma = 0.01;      // pose jitter, rotation (rad/s^0.5)
+  // The translational noises (accel_sigma, position_sigma, ground_height_sigma and the SfM
+  // filter's) hold at the cloud's mean camera depth and scale with each particle's depth:
+  // every depth hypothesis then predicts the same bearing jitter, so the smoothness of the
+  // bearings does not favour far hypotheses (with noise in units, a farther particle's
+  // bearing jitters less and the filter drifts to the far edge of its cues).
+  bool depth_relative_noise = true;
   // Measurement (eq. 5.2).
   double bearing_sigma_px = 2.0;    // eta: bearing noise of the reference point (px)
   double min_depth = 0.2;           // particles nearer than this to the camera are invalid (units)
@@ -201,6 +210,8 @@ struct BearingOnlyTrackerOptions {
     v("angular_accel_sigma", &angular_accel_sigma, "white-noise angular acceleration (rad/s^1.5)");
     v("position_sigma", &position_sigma, "pose jitter, translation (units/s^0.5)");
     v("rotation_sigma", &rotation_sigma, "pose jitter, rotation (rad/s^0.5)");
+    v("depth_relative_noise", &depth_relative_noise,
+      "translational noises hold at the cloud's mean depth, scale with each particle's depth");
     v("bearing_sigma_px", &bearing_sigma_px, "eta: bearing noise of the reference point (px)");
     v("min_depth", &min_depth, "particles nearer than this are invalid (units)");
     v("resample_ess_ratio", &resample_ess_ratio, "resample when ESS < ratio * N (0, 1]");
@@ -376,6 +387,9 @@ class BearingOnlyTracker {
   void Propagate(double dt, const StepCues& cues, std::vector<double>* truncation_log_weight);
   void SeatVelocities(const BotObservation& observation, const StepCues& cues);
   void HoldOnRay(const BotObservation& observation);
+  // Per particle: its camera depth over the cloud's weighted mean depth (1 when
+  // depth_relative_noise is off), for the translational process noise.
+  std::vector<double> NoiseScales() const;
   bool WeightByBearing(const BotObservation& observation,
                        const std::vector<double>& truncation_log_weight);
   bool SfmUsable(const BotObservation& observation) const;

@@ -81,6 +81,17 @@ void CollectInliers(const std::vector<Eigen::Vector3d>& points, const GroundPlan
   }
 }
 
+// Share of the finite points within `threshold` of `plane` [0, 1].
+double Support(const std::vector<Eigen::Vector3d>& points, const GroundPlane& plane, double threshold) {
+  int n = 0, in = 0;
+  for (const Eigen::Vector3d& p : points) {
+    if (!p.allFinite()) continue;
+    ++n;
+    in += std::abs(plane.Height(p)) <= threshold;
+  }
+  return n > 0 ? static_cast<double>(in) / n : 0.0;
+}
+
 }  // namespace
 
 Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
@@ -229,9 +240,23 @@ Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points
                          " of the points, below min_support");
   }
   *estimate = free_fit;
-  const double h = free_fit.plane.Height(camera);
+  double h = free_fit.plane.Height(camera);
   if (!(h > 0.0)) {
     return Status::Error("EstimateGroundPlaneAlongTravel: the camera is " + std::to_string(-h) + " below the plane");
+  }
+  // The band in camera heights: a band wide against the camera's height takes in what
+  // stands on the ground, and the plane fitted to it rises above the ground. Support
+  // (min_support) stays measured in the world-unit band.
+  GroundPlaneOptions narrowed = options;
+  const double band = options.inlier_threshold_camera_heights * h;
+  if (band > 0.0 && band < options.inlier_threshold) {
+    narrowed.inlier_threshold = band;
+    GroundPlaneEstimate refit;
+    if (EstimateGroundPlane(points, up_hint, narrowed, &refit).ok() && refit.plane.Height(camera) > 0.0) {
+      free_fit = refit;
+      *estimate = refit;
+      h = refit.plane.Height(camera);
+    }
   }
   if (centres.empty() || options.path_parallel_min_spread <= 0.0) return Status::Ok();
   const double min_spread = options.path_parallel_min_spread;
@@ -246,8 +271,8 @@ Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points
     while (SpreadAlong(centres, directions.back()) < min_spread * h) directions.pop_back();
   }
   GroundPlaneEstimate constrained;
-  bool use_constrained = EstimateGroundPlane(points, up_hint, options, directions, &constrained).ok() &&
-                         constrained.inlier_ratio >= options.min_support;
+  bool use_constrained = EstimateGroundPlane(points, up_hint, narrowed, directions, &constrained).ok() &&
+                         Support(points, constrained.plane, options.inlier_threshold) >= options.min_support;
   const double hc = constrained.plane.Height(camera);
   if (use_constrained) use_constrained = hc > 0.0;
   if (use_constrained && short_travel) use_constrained = SpreadAlong(centres, directions.front()) >= min_spread * hc;

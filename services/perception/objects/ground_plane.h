@@ -38,6 +38,14 @@ struct GroundPlane {
 struct GroundPlaneOptions {
   int max_iterations = 400;        // RANSAC hypotheses (count)
   double inlier_threshold = 0.05;  // point-to-plane distance of an inlier (world units)
+  // A band in world units means nothing in an up-to-scale map: when the camera's height
+  // above the first fit is small against it, the points within the band include much of
+  // what stands on the ground (kerbs, parked cars, walls' feet), all on one side, and the
+  // least-squares plane rises above the ground. With the camera's position known
+  // (EstimateGroundPlaneAlongTravel), the plane is refitted with the band narrowed to this
+  // fraction of the camera's height above the first fit, if that is narrower; the first
+  // fit still decides whether there is a ground at all (min_support). 0 = world units only.
+  double inlier_threshold_camera_heights = 0.15;
   double max_tilt_deg = 25.0;      // angle between the normal and the up hint at most (deg)
   int min_inliers = 20;            // fewer inliers: no plane (count)
   double min_inlier_ratio = 0.05;  // ... or a smaller share of the points: no plane [0, 1]
@@ -64,6 +72,7 @@ struct GroundPlaneOptions {
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(max_iterations, 0);
     MBSLAM_CHECK_OPTION_GT(inlier_threshold, 0.0);
+    MBSLAM_CHECK_OPTION_GE(inlier_threshold_camera_heights, 0.0);
     MBSLAM_CHECK_OPTION(max_tilt_deg > 0.0 && max_tilt_deg < 90.0);
     MBSLAM_CHECK_OPTION_GE(min_inliers, 3);
     MBSLAM_CHECK_OPTION(min_inlier_ratio >= 0.0 && min_inlier_ratio <= 1.0);
@@ -80,6 +89,8 @@ struct GroundPlaneOptions {
   void VisitFields(V& v) {
     v("max_iterations", &max_iterations, "RANSAC hypotheses (count)");
     v("inlier_threshold", &inlier_threshold, "point-to-plane distance of an inlier (world units)");
+    v("inlier_threshold_camera_heights", &inlier_threshold_camera_heights,
+      "camera position known: refit with the band narrowed to this fraction of the camera's height above the first fit, if narrower; 0 = world units only");
     v("max_tilt_deg", &max_tilt_deg, "angle between the normal and the up hint at most (deg)");
     v("min_inliers", &min_inliers, "fewer inliers: no plane (count)");
     v("min_inlier_ratio", &min_inlier_ratio, "smaller inlier share: no plane [0, 1]");
@@ -143,7 +154,9 @@ double SpreadAlong(const std::vector<Eigen::Vector3d>& centres, const Eigen::Vec
 // above that plane. Either refit needs min_support. Without a refit, a free fit tilted
 // from the longest direction of travel by more than max_travel_tilt_deg is refused (an
 // error: no plane). `centres` empty: the free fit. `camera` is the latest camera centre;
-// `along_travel` says which plane was returned.
+// `along_travel` says which plane was returned. All fits after the first use the inlier
+// band narrowed to inlier_threshold_camera_heights of the camera's height above the first
+// fit when that is narrower than inlier_threshold.
 Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up_hint,
                                       const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& camera,
                                       const GroundPlaneOptions& options, GroundPlaneEstimate* estimate,

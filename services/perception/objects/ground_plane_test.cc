@@ -150,6 +150,7 @@ TEST(GroundPlane, AlongTravelRejectsASlopeThatOutnumbersTheGround) {
   }
   GroundPlaneOptions options;
   options.inlier_threshold = 0.05;
+  options.inlier_threshold_camera_heights = 0.0;  // the band in world units throughout (tested below)
   GroundPlaneEstimate free_fit;
   ASSERT_TRUE(EstimateGroundPlane(points, Eigen::Vector3d::UnitZ(), options, &free_fit).ok());
   EXPECT_GT(std::abs(free_fit.plane.normal.x()), std::sin(15.0 * M_PI / 180.0));  // the slope won
@@ -187,6 +188,48 @@ TEST(GroundPlane, AlongTravelRejectsASlopeThatOutnumbersTheGround) {
   options.min_support = 0.9;
   EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), centres, camera, options, &estimate,
                                               &along).ok());
+}
+
+// An up-to-scale map whose unit is large against the camera's height (0.03 units above
+// the ground, band 0.05 units): the ground's points (0.002 noise) and as many points of
+// things standing on it (up to half the camera's height: kerbs, car bodies, walls' feet)
+// all fall within the band, on one side, and the plane fitted to them rises above the
+// ground. Refitted with the band narrowed to 0.15 camera heights, the plane is the ground
+// (within 3 % of the camera's height; the wide band's is more than 10 % too high).
+TEST(GroundPlane, BandInCameraHeightsKeepsThePlaneOnTheGround) {
+  ParticleRng rng(11);
+  std::vector<Eigen::Vector3d> points;
+  const double h = 0.03;
+  for (int i = 0; i < 400; ++i) {
+    points.emplace_back(rng.Uniform(0.1, 1.5), rng.Uniform(-0.3, 0.3), -h + rng.Normal(0.0, 0.002));
+  }
+  for (int i = 0; i < 400; ++i) {
+    points.emplace_back(rng.Uniform(0.1, 1.5), rng.Uniform(-0.3, 0.3), -h + rng.Uniform(0.0, 0.5 * h));
+  }
+  std::vector<Eigen::Vector3d> centres;
+  for (int k = 0; k < 12; ++k) centres.emplace_back(0.01 * k, 0.0, 0.0);
+  const Eigen::Vector3d camera = centres.back();
+  GroundPlaneOptions options;
+  options.inlier_threshold = 0.05;
+  options.inlier_threshold_camera_heights = 0.0;  // world units only: the plane rises
+  GroundPlaneEstimate estimate;
+  bool along = false;
+  ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate,
+                                             &along).ok());
+  EXPECT_LT(estimate.plane.Height(camera), 0.9 * h);
+  options.inlier_threshold_camera_heights = 0.15;
+  ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate,
+                                             &along).ok());
+  EXPECT_NEAR(estimate.plane.Height(camera), h, 0.03 * h);
+  EXPECT_GT(estimate.plane.normal.z(), 0.999);
+  ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), centres, camera, options, &estimate,
+                                             &along).ok());
+  EXPECT_NEAR(estimate.plane.Height(camera), h, 0.03 * h);
+  // Support is still measured in the world-unit band: the narrowed fit holds only the
+  // ground's half of the points, yet the plane is kept at min_support 0.6.
+  options.min_support = 0.6;
+  EXPECT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), centres, camera, options, &estimate,
+                                             &along).ok());
 }
 
 }  // namespace
