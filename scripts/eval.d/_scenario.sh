@@ -65,6 +65,12 @@ out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float
        "relative_scale_error": (sum(scales) / len(scales)) if scales else None,
        "predicted_hit_rate_1s": obj.get("volume_hit_rate") if obj.get("volumes_checked") else None,
        "predicted_hit_rate_0_5s": obj05.get("volume_hit_rate") if obj05.get("volumes_checked") else None,
+       "predicted_hit_rate_1s_all_estimates": obj.get("volume_hit_rate_all") if obj.get("volumes_checked_all") else None,
+       "predicted_hit_rate_0_5s_all_estimates":
+           obj05.get("volume_hit_rate_all") if obj05.get("volumes_checked_all") else None,
+       "object_samples_matched_share": obj.get("matched_sample_share"),
+       "object_samples_fragment_share": obj.get("fragment_sample_share"),
+       "object_samples_phantom_share": obj.get("phantom_sample_share"),
        "predicted_volume_ratio_1s": obj.get("volume_ratio_median"),
        "predicted_volume_ratio_0_5s": obj05.get("volume_ratio_median"),
        "objects": [{k: o.get(k) for k in ("est_id", "name", "samples", "settled_samples", "pos_err_rel_settled_mean",
@@ -89,6 +95,10 @@ if obj:
           f"error/range from 2 s {out['object_pos_err_rel_2s']}, relative scale error {out['relative_scale_error']}, "
           f"volumes hit +0.5 s {out['predicted_hit_rate_0_5s']} +1 s {out['predicted_hit_rate_1s']} "
           f"(median size x the true box: {out['predicted_volume_ratio_0_5s']} / {out['predicted_volume_ratio_1s']})")
+    print(f"  every estimate near a body: volumes hit +0.5 s {out['predicted_hit_rate_0_5s_all_estimates']} "
+          f"+1 s {out['predicted_hit_rate_1s_all_estimates']}; object samples: matched "
+          f"{out['object_samples_matched_share']}, fragments {out['object_samples_fragment_share']}, "
+          f"phantoms {out['object_samples_phantom_share']}")
 if rec.get("scored"):
     print(f"  reconstructions: {rec.get('reconstructions')} ({rec.get('scored')} scored); the longest "
           f"({rec.get('object_reconstruction_body')}, {rec.get('object_reconstruction_images')} images): camera-relative "

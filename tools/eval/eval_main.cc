@@ -561,6 +561,15 @@ int RunObjects(const Args& args) {
       "m)\n",
       result.num_est_objects, result.num_gt_bodies, result.objects.size(), result.unmatched_est,
       ate.translation.rmse);
+  const double all_samples = std::max(result.est_samples, 1);
+  std::printf(
+      "unmatched: %d fragments (near a true body, %.3f of the samples), %d phantoms (near none, %.3f), "
+      "%d short; matched estimates hold %.3f of the %d samples\n",
+      result.unmatched_fragments, result.fragment_samples / all_samples, result.unmatched_phantoms,
+      result.phantom_samples / all_samples, result.unmatched_short,
+      (result.est_samples - result.unmatched_samples) / all_samples, result.est_samples);
+  std::printf("predicted volumes of every estimate near a body: %d of %d contain its true centre (%.3f)\n",
+              result.volumes_hit_all, result.volumes_checked_all, result.hit_rate_all);
   Json list = Json::Array();
   for (const auto& o : result.objects) {
     std::printf(
@@ -629,6 +638,14 @@ int RunObjects(const Args& args) {
       .Set("est_objects", result.num_est_objects)
       .Set("gt_bodies", result.num_gt_bodies);
   j.Set("matched", result.objects.size()).Set("unmatched_est", result.unmatched_est);
+  j.Set("unmatched_fragments", result.unmatched_fragments)
+      .Set("unmatched_phantoms", result.unmatched_phantoms)
+      .Set("unmatched_short", result.unmatched_short)
+      .Set("fragment_sample_share", result.fragment_samples / all_samples)
+      .Set("phantom_sample_share", result.phantom_samples / all_samples)
+      .Set("matched_sample_share", (result.est_samples - result.unmatched_samples) / all_samples)
+      .Set("volume_hit_rate_all", result.hit_rate_all)
+      .Set("volumes_checked_all", result.volumes_checked_all);
   j.Set("volume_hit_rate", result.hit_rate).Set("volumes_checked", result.volumes_checked);
   if (result.volume_ratio_median >= 0.0) j.Set("volume_ratio_median", result.volume_ratio_median);
   j.Set("settle_us", options.settle_us).Set("settled_samples", result.settled_samples);

@@ -144,8 +144,20 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
   std::vector<double> all_rel, all_ratios;
   for (size_t i = 0; i < est_list.size(); ++i) {
     const int j = assignment[i];
+    result->est_samples += static_cast<int>(est_list[i]->samples.size());
     if (j < 0 || cost(static_cast<Eigen::Index>(i), j) >= kForbidden) {
       ++result->unmatched_est;
+      result->unmatched_samples += static_cast<int>(est_list[i]->samples.size());
+      const int n = static_cast<int>(est_list[i]->samples.size());
+      if (cost.row(static_cast<Eigen::Index>(i)).minCoeff() < kForbidden) {
+        ++result->unmatched_fragments;
+        result->fragment_samples += n;
+      } else if (n < options.min_samples) {
+        ++result->unmatched_short;
+      } else {
+        ++result->unmatched_phantoms;
+        result->phantom_samples += n;
+      }
       continue;
     }
     const ObjectEstimate& est = *est_list[i];
@@ -230,6 +242,35 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     result->volumes_hit += r.volumes_hit;
     result->objects.push_back(r);
   }
+  // Every estimate's volumes against the body nearest to its sample.
+  const Sim3d est_from_gt_all = gt_from_est.Inverse();
+  for (const ObjectEstimate* est : est_list) {
+    for (const auto& s : est->samples) {
+      const Eigen::Vector3d p = gt_from_est * s.position;
+      const BodyTruth* nearest = nullptr;
+      double best = options.max_match_distance;
+      for (const BodyTruth* body : gt_list) {
+        Rigid3d pose;
+        if (!InterpolatePose(body->poses, s.utime, 1000000, &pose)) continue;
+        const double d = (pose.translation - p).norm();
+        if (d <= best) {
+          best = d;
+          nearest = body;
+        }
+      }
+      if (nearest == nullptr) continue;
+      for (const auto& v : s.volumes) {
+        if (std::llabs(v.horizon_us - options.horizon_us) > options.horizon_tolerance_us) continue;
+        Rigid3d body_pose;
+        if (!InterpolatePose(nearest->poses, v.utime, 1000000, &body_pose)) continue;
+        ++result->volumes_checked_all;
+        if (v.Contains(est_from_gt_all * body_pose.translation)) ++result->volumes_hit_all;
+      }
+    }
+  }
+  result->hit_rate_all = result->volumes_checked_all > 0
+                             ? static_cast<double>(result->volumes_hit_all) / result->volumes_checked_all
+                             : 0.0;
   result->settled_samples = static_cast<int>(all_rel.size());
   if (!all_rel.empty()) {
     double sum = 0.0;

@@ -119,6 +119,23 @@ struct ObjectsEvaluation {
   int num_est_objects = 0;
   int num_gt_bodies = 0;
   int unmatched_est = 0;
+  // Of the unmatched estimates: fragments lie within max_match_distance of a true body
+  // over min_samples common samples (a body followed by more than one estimate, or a
+  // piece of one); short ones have fewer than min_samples samples; phantoms are the rest,
+  // long enough and near no body.
+  int unmatched_fragments = 0;
+  int unmatched_short = 0;
+  int unmatched_phantoms = 0;
+  int est_samples = 0;        // samples of all estimates
+  int unmatched_samples = 0;  // samples of the unmatched estimates
+  int fragment_samples = 0;   // of those, of the fragments
+  int phantom_samples = 0;    // of those, of the phantoms
+  // Predicted volumes of every estimate, matched or not, each sample checked against the
+  // true body nearest to it then (within max_match_distance): what a planner sees,
+  // fragments included. Samples near no body are not checked (see phantom_samples).
+  int volumes_checked_all = 0;
+  int volumes_hit_all = 0;
+  double hit_rate_all = 0.0;
   int volumes_checked = 0;
   int volumes_hit = 0;
   double hit_rate = 0.0;  // over all matched objects

@@ -75,6 +75,11 @@ TEST(ObjectMetrics, ScaleAboutTheCameraAndDepth) {
   ASSERT_TRUE(EvaluateObjects(est, scene.bodies, scene.camera, gt_from_est, options, &r).ok());
   EXPECT_EQ(r.num_est_objects, 3);
   EXPECT_EQ(r.unmatched_est, 1);
+  EXPECT_EQ(r.unmatched_phantoms, 1);  // the estimate at (500, 500, 0) is near no body
+  EXPECT_EQ(r.unmatched_fragments, 0);
+  EXPECT_EQ(r.unmatched_samples, static_cast<int>(est[11].samples.size()));
+  EXPECT_EQ(r.est_samples, static_cast<int>(est[7].samples.size() + est[9].samples.size() +
+                                            est[11].samples.size()));
   ASSERT_EQ(r.objects.size(), 2u);
   const ObjectResult& car = r.objects[0];
   EXPECT_EQ(car.est_id, 7);
@@ -133,6 +138,26 @@ TEST(ObjectMetrics, PredictedVolumeHitRate) {
   // Size of the predictions against the true box: 2 x 2 x 2 m over 4.2 x 1.8 x 1.5 m.
   EXPECT_NEAR(r.objects[0].volume_ratio_median, 8.0 / (4.2 * 1.8 * 1.5), 1e-9);
   EXPECT_NEAR(r.volume_ratio_median, 8.0 / (4.2 * 1.8 * 1.5), 1e-9);
+  // With only the matched estimate, every estimate's volumes are its volumes.
+  EXPECT_EQ(r.volumes_checked_all, 30);
+  EXPECT_EQ(r.volumes_hit_all, 15);
+  // A second estimate of the car (a fragment) whose volumes all hold the truth counts
+  // in the all-estimates rate only.
+  est[4] = est[3];
+  est[4].id = 4;
+  for (ObjectSample& s : est[4].samples) {
+    s.position += Eigen::Vector3d(0.0, 0.5, 0.0);
+    Rigid3d future;
+    ASSERT_TRUE(InterpolatePose(car.poses, s.volumes[0].utime, 100000, &future));
+    s.volumes[0].center = future.translation;
+  }
+  ASSERT_TRUE(
+      EvaluateObjects(est, scene.bodies, scene.camera, Sim3d(), ObjectMetricsOptions(), &r).ok());
+  EXPECT_EQ(r.unmatched_fragments, 1);
+  EXPECT_EQ(r.volumes_checked, 30);
+  EXPECT_EQ(r.volumes_checked_all, 60);
+  EXPECT_EQ(r.volumes_hit_all, 45);
+  EXPECT_DOUBLE_EQ(r.hit_rate_all, 0.75);
 }
 
 TEST(PredictedVolume, OrientedContainment) {
@@ -145,6 +170,45 @@ TEST(PredictedVolume, OrientedContainment) {
   EXPECT_FALSE(v.Contains(Eigen::Vector3d(2.2, -0.2, 0.0)));  // across it
   EXPECT_FALSE(v.Contains(Eigen::Vector3d(1, 1, 1.5)));
 }
+
+TEST(ObjectMetrics, UnmatchedEstimatesAreFragmentsOrPhantoms) {
+  const Scene scene = MakeScene();
+  const Sim3d gt_from_est;  // identity
+  std::map<int, ObjectEstimate> est;
+  for (size_t i = 0; i < scene.camera.size(); ++i) {
+    const Eigen::Vector3d person = scene.bodies.at(2).poses[i].pose.translation;
+    ObjectSample a;
+    a.utime = scene.camera[i].utime;
+    a.position = person;
+    est[1].samples.push_back(a);
+    a.position = person + Eigen::Vector3d(0.0, 0.3, 0.0);  // a second estimate of the person
+    est[2].samples.push_back(a);
+    if (i % 2 == 0) {
+      a.position = Eigen::Vector3d(-40.0, 40.0, 0.0);  // near nothing
+      est[3].samples.push_back(a);
+    }
+  }
+  for (auto& [id, e] : est) e.id = id;
+  ObjectsEvaluation r;
+  ASSERT_TRUE(EvaluateObjects(est, scene.bodies, scene.camera, gt_from_est, ObjectMetricsOptions(), &r).ok());
+  ASSERT_EQ(r.objects.size(), 1u);
+  EXPECT_EQ(r.objects[0].est_id, 1);
+  EXPECT_EQ(r.unmatched_est, 2);
+  EXPECT_EQ(r.unmatched_fragments, 1);
+  EXPECT_EQ(r.unmatched_phantoms, 1);
+  EXPECT_EQ(r.est_samples, static_cast<int>(est[1].samples.size() + est[2].samples.size() + est[3].samples.size()));
+  EXPECT_EQ(r.unmatched_samples, static_cast<int>(est[2].samples.size() + est[3].samples.size()));
+  EXPECT_EQ(r.fragment_samples, static_cast<int>(est[2].samples.size()));
+  EXPECT_EQ(r.phantom_samples, static_cast<int>(est[3].samples.size()));
+  EXPECT_EQ(r.unmatched_short, 0);
+  // One sample near nothing is too short to call a phantom.
+  est[4].id = 4;
+  est[4].samples.push_back(est[3].samples.front());
+  ASSERT_TRUE(EvaluateObjects(est, scene.bodies, scene.camera, gt_from_est, ObjectMetricsOptions(), &r).ok());
+  EXPECT_EQ(r.unmatched_short, 1);
+  EXPECT_EQ(r.unmatched_phantoms, 1);
+}
+
 
 }  // namespace
 }  // namespace eval
