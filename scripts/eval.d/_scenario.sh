@@ -68,6 +68,8 @@ out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float
        "predicted_hit_rate_1s_all_estimates": obj.get("volume_hit_rate_all") if obj.get("volumes_checked_all") else None,
        "predicted_hit_rate_0_5s_all_estimates":
            obj05.get("volume_hit_rate_all") if obj05.get("volumes_checked_all") else None,
+       "predicted_overlap_rate_1s_all_estimates":
+           obj.get("volume_overlap_rate_all") if obj.get("volumes_checked_all") else None,
        "object_samples_matched_share": obj.get("matched_sample_share"),
        "object_samples_fragment_share": obj.get("fragment_sample_share"),
        "object_samples_phantom_share": obj.get("phantom_sample_share"),
@@ -96,7 +98,8 @@ if obj:
           f"volumes hit +0.5 s {out['predicted_hit_rate_0_5s']} +1 s {out['predicted_hit_rate_1s']} "
           f"(median size x the true box: {out['predicted_volume_ratio_0_5s']} / {out['predicted_volume_ratio_1s']})")
     print(f"  every estimate near a body: volumes hit +0.5 s {out['predicted_hit_rate_0_5s_all_estimates']} "
-          f"+1 s {out['predicted_hit_rate_1s_all_estimates']}; object samples: matched "
+          f"+1 s {out['predicted_hit_rate_1s_all_estimates']} (+1 s volumes overlapping the true box "
+          f"{out['predicted_overlap_rate_1s_all_estimates']}); object samples: matched "
           f"{out['object_samples_matched_share']}, fragments {out['object_samples_fragment_share']}, "
           f"phantoms {out['object_samples_phantom_share']}")
 if rec.get("scored"):

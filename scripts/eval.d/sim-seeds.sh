@@ -37,6 +37,7 @@ import json, sys
 keys = ["ate_rel_path", "tracked_fraction", "scale_error", "moving_recall", "moving_precision", "object_pos_err_rel_2s",
         "relative_scale_error", "predicted_hit_rate_0_5s", "predicted_hit_rate_1s",
         "predicted_hit_rate_0_5s_all_estimates", "predicted_hit_rate_1s_all_estimates",
+        "predicted_overlap_rate_1s_all_estimates",
         "object_samples_matched_share", "object_samples_phantom_share", "occupancy_precision",
         "occupancy_recall", "object_traj_err_rel", "object_shape_err_rel", "track_misclassification"]
 args = sys.argv[1:]

@@ -568,8 +568,11 @@ int RunObjects(const Args& args) {
       result.unmatched_fragments, result.fragment_samples / all_samples, result.unmatched_phantoms,
       result.phantom_samples / all_samples, result.unmatched_short,
       (result.est_samples - result.unmatched_samples) / all_samples, result.est_samples);
-  std::printf("predicted volumes of every estimate near a body: %d of %d contain its true centre (%.3f)\n",
-              result.volumes_hit_all, result.volumes_checked_all, result.hit_rate_all);
+  std::printf(
+      "predicted volumes of every estimate near a body: %d of %d contain its true centre (%.3f), %d overlap its "
+      "true box (%.3f)\n",
+      result.volumes_hit_all, result.volumes_checked_all, result.hit_rate_all, result.volumes_overlapping_all,
+      result.overlap_rate_all);
   Json list = Json::Array();
   for (const auto& o : result.objects) {
     std::printf(
@@ -645,6 +648,7 @@ int RunObjects(const Args& args) {
       .Set("phantom_sample_share", result.phantom_samples / all_samples)
       .Set("matched_sample_share", (result.est_samples - result.unmatched_samples) / all_samples)
       .Set("volume_hit_rate_all", result.hit_rate_all)
+      .Set("volume_overlap_rate_all", result.overlap_rate_all)
       .Set("volumes_checked_all", result.volumes_checked_all);
   j.Set("volume_hit_rate", result.hit_rate).Set("volumes_checked", result.volumes_checked);
   if (result.volume_ratio_median >= 0.0) j.Set("volume_ratio_median", result.volume_ratio_median);

@@ -14,6 +14,33 @@ bool PredictedVolume::Contains(const Eigen::Vector3d& point) const {
   return (local.cwiseAbs().array() <= half_extent.array()).all();
 }
 
+bool PredictedVolume::Overlaps(const Eigen::Vector3d& other_center,
+                               const Eigen::Quaterniond& other_orientation,
+                               const Eigen::Vector3d& other_half_extent) const {
+  // Separating axis test of two oriented boxes: the 3 + 3 face normals and their 9 cross
+  // products; the boxes are apart when their projections on one axis do not meet.
+  const Eigen::Matrix3d A = orientation.toRotationMatrix();
+  const Eigen::Matrix3d B = other_orientation.toRotationMatrix();
+  const Eigen::Vector3d d = other_center - center;
+  auto separated = [&](const Eigen::Vector3d& axis) {
+    const double n = axis.norm();
+    if (n < 1e-12) return false;  // parallel edges: covered by the face normals
+    const Eigen::Vector3d u = axis / n;
+    const double ra = (A.transpose() * u).cwiseAbs().dot(half_extent);
+    const double rb = (B.transpose() * u).cwiseAbs().dot(other_half_extent);
+    return std::abs(d.dot(u)) > ra + rb;
+  };
+  for (int i = 0; i < 3; ++i) {
+    if (separated(A.col(i)) || separated(B.col(i))) return false;
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (separated(A.col(i).cross(B.col(j)))) return false;
+    }
+  }
+  return true;
+}
+
 bool InterpolatePose(const Trajectory& poses, int64_t utime, int64_t max_gap_us, Rigid3d* pose) {
   if (poses.empty()) {
     return false;
@@ -265,9 +292,18 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
         if (!InterpolatePose(nearest->poses, v.utime, 1000000, &body_pose)) continue;
         ++result->volumes_checked_all;
         if (v.Contains(est_from_gt_all * body_pose.translation)) ++result->volumes_hit_all;
+        if (nearest->extent.allFinite() && (nearest->extent.array() > 0.0).all() &&
+            v.Overlaps(est_from_gt_all * body_pose.translation,
+                       est_from_gt_all.rotation * body_pose.rotation,
+                       0.5 * nearest->extent / gt_from_est.scale)) {
+          ++result->volumes_overlapping_all;
+        }
       }
     }
   }
+  result->overlap_rate_all = result->volumes_checked_all > 0
+                                 ? static_cast<double>(result->volumes_overlapping_all) / result->volumes_checked_all
+                                 : 0.0;
   result->hit_rate_all = result->volumes_checked_all > 0
                              ? static_cast<double>(result->volumes_hit_all) / result->volumes_checked_all
                              : 0.0;

@@ -37,6 +37,10 @@ struct PredictedVolume {
 
   // True if `point` (estimate world frame) is inside the box.
   bool Contains(const Eigen::Vector3d& point) const;
+  // True if the box and the box (center, world_from_box, half_extent) share a point
+  // (separating axis test).
+  bool Overlaps(const Eigen::Vector3d& other_center, const Eigen::Quaterniond& other_orientation,
+                const Eigen::Vector3d& other_half_extent) const;
 };
 
 struct ObjectSample {
@@ -136,6 +140,10 @@ struct ObjectsEvaluation {
   int volumes_checked_all = 0;
   int volumes_hit_all = 0;
   double hit_rate_all = 0.0;
+  // Of those, the volumes that overlap the true box at all (a fragment's box around a
+  // part of a body can miss its centre yet cover some of it); needs the true extent.
+  int volumes_overlapping_all = 0;
+  double overlap_rate_all = 0.0;
   int volumes_checked = 0;
   int volumes_hit = 0;
   double hit_rate = 0.0;  // over all matched objects

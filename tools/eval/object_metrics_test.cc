@@ -158,6 +158,9 @@ TEST(ObjectMetrics, PredictedVolumeHitRate) {
   EXPECT_EQ(r.volumes_checked_all, 60);
   EXPECT_EQ(r.volumes_hit_all, 45);
   EXPECT_DOUBLE_EQ(r.hit_rate_all, 0.75);
+  // The volumes 3 m off the car's centre sideways (box half size 1 m, turned 0.3 rad: at
+  // most 1.3 m across) do not reach its 1.8 m wide box either; the others overlap it.
+  EXPECT_EQ(r.volumes_overlapping_all, 45);
 }
 
 TEST(PredictedVolume, OrientedContainment) {
@@ -209,6 +212,30 @@ TEST(ObjectMetrics, UnmatchedEstimatesAreFragmentsOrPhantoms) {
   EXPECT_EQ(r.unmatched_phantoms, 1);
 }
 
+
+TEST(ObjectMetrics, OrientedBoxOverlap) {
+  PredictedVolume v;
+  v.center = Eigen::Vector3d::Zero();
+  v.half_extent = Eigen::Vector3d(1.0, 1.0, 1.0);
+  const Eigen::Quaterniond I = Eigen::Quaterniond::Identity();
+  const Eigen::Vector3d h(0.5, 0.5, 0.5);
+  EXPECT_TRUE(v.Overlaps(Eigen::Vector3d(1.4, 0.0, 0.0), I, h));   // faces 0.1 apart inward
+  EXPECT_FALSE(v.Overlaps(Eigen::Vector3d(1.6, 0.0, 0.0), I, h));  // 0.1 apart
+  EXPECT_FALSE(v.Overlaps(Eigen::Vector3d(0.0, 0.0, -1.6), I, h));
+  // Turned 45 deg about z, the small box reaches 0.5 * sqrt(2) = 0.707 along x.
+  const Eigen::Quaterniond r(Eigen::AngleAxisd(M_PI / 4.0, Eigen::Vector3d::UnitZ()));
+  EXPECT_TRUE(v.Overlaps(Eigen::Vector3d(1.65, 0.0, 0.0), r, h));
+  EXPECT_FALSE(v.Overlaps(Eigen::Vector3d(1.75, 0.0, 0.0), r, h));
+  // Corner to corner along the diagonal: apart only along an edge-cross axis or a face.
+  EXPECT_FALSE(v.Overlaps(Eigen::Vector3d(1.6, 1.6, 1.6), I, h));
+  EXPECT_TRUE(v.Overlaps(Eigen::Vector3d(1.4, 1.4, 1.4), I, h));
+  // Symmetric.
+  PredictedVolume w;
+  w.center = Eigen::Vector3d(1.65, 0.0, 0.0);
+  w.orientation = r;
+  w.half_extent = h;
+  EXPECT_TRUE(w.Overlaps(Eigen::Vector3d::Zero(), I, v.half_extent));
+}
 
 }  // namespace
 }  // namespace eval
