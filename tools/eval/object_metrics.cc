@@ -67,6 +67,16 @@ bool InterpolatePose(const Trajectory& poses, int64_t utime, int64_t max_gap_us,
 
 namespace {
 
+// The body's true pose at the time a volume predicts for, if the volume is at the scored
+// horizon and the truth reaches that time.
+bool TruePoseForVolume(const PredictedVolume& v, const BodyTruth& body,
+                       const ObjectMetricsOptions& options, Rigid3d* pose) {
+  if (std::llabs(v.horizon_us - options.horizon_us) > options.horizon_tolerance_us) return false;
+  return InterpolatePose(body.poses, v.utime, 1000000, pose);
+}
+
+double Ratio(int num, int den) { return den > 0 ? static_cast<double>(num) / den : 0.0; }
+
 double MedianOrNegative(std::vector<double> v) {
   if (v.empty()) return -1.0;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
@@ -168,14 +178,15 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     }
   }
   const std::vector<int> assignment = SolveAssignment(cost);
+  const Sim3d est_from_gt = gt_from_est.Inverse();
   std::vector<double> all_rel, all_ratios;
   for (size_t i = 0; i < est_list.size(); ++i) {
     const int j = assignment[i];
-    result->est_samples += static_cast<int>(est_list[i]->samples.size());
+    const int n = static_cast<int>(est_list[i]->samples.size());
+    result->est_samples += n;
     if (j < 0 || cost(static_cast<Eigen::Index>(i), j) >= kForbidden) {
       ++result->unmatched_est;
-      result->unmatched_samples += static_cast<int>(est_list[i]->samples.size());
-      const int n = static_cast<int>(est_list[i]->samples.size());
+      result->unmatched_samples += n;
       if (cost.row(static_cast<Eigen::Index>(i)).minCoeff() < kForbidden) {
         ++result->unmatched_fragments;
         result->fragment_samples += n;
@@ -238,17 +249,11 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     r.position_error_scaled = ErrorStats::From(scaled);
     r.depth_error = ErrorStats::From(depth);
     // Predicted volumes at the horizon: does the true centre lie inside the box?
-    const Sim3d est_from_gt = gt_from_est.Inverse();
     std::vector<double> ratios;
     for (const auto& s : est.samples) {
       for (const auto& v : s.volumes) {
-        if (std::llabs(v.horizon_us - options.horizon_us) > options.horizon_tolerance_us) {
-          continue;
-        }
         Rigid3d body_pose;
-        if (!InterpolatePose(body.poses, v.utime, 1000000, &body_pose)) {
-          continue;  // beyond the truth
-        }
+        if (!TruePoseForVolume(v, body, options, &body_pose)) continue;
         ++r.volumes_checked;
         if (v.Contains(est_from_gt * body_pose.translation)) {
           ++r.volumes_hit;
@@ -262,15 +267,13 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
         }
       }
     }
-    r.hit_rate =
-        r.volumes_checked > 0 ? static_cast<double>(r.volumes_hit) / r.volumes_checked : 0.0;
+    r.hit_rate = Ratio(r.volumes_hit, r.volumes_checked);
     r.volume_ratio_median = MedianOrNegative(ratios);
     result->volumes_checked += r.volumes_checked;
     result->volumes_hit += r.volumes_hit;
     result->objects.push_back(r);
   }
   // Every estimate's volumes against the body nearest to its sample.
-  const Sim3d est_from_gt_all = gt_from_est.Inverse();
   for (const ObjectEstimate* est : est_list) {
     for (const auto& s : est->samples) {
       const Eigen::Vector3d p = gt_from_est * s.position;
@@ -287,26 +290,20 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
       }
       if (nearest == nullptr) continue;
       for (const auto& v : s.volumes) {
-        if (std::llabs(v.horizon_us - options.horizon_us) > options.horizon_tolerance_us) continue;
         Rigid3d body_pose;
-        if (!InterpolatePose(nearest->poses, v.utime, 1000000, &body_pose)) continue;
+        if (!TruePoseForVolume(v, *nearest, options, &body_pose)) continue;
         ++result->volumes_checked_all;
-        if (v.Contains(est_from_gt_all * body_pose.translation)) ++result->volumes_hit_all;
+        if (v.Contains(est_from_gt * body_pose.translation)) ++result->volumes_hit_all;
         if (nearest->extent.allFinite() && (nearest->extent.array() > 0.0).all() &&
-            v.Overlaps(est_from_gt_all * body_pose.translation,
-                       est_from_gt_all.rotation * body_pose.rotation,
+            v.Overlaps(est_from_gt * body_pose.translation, est_from_gt.rotation * body_pose.rotation,
                        0.5 * nearest->extent / gt_from_est.scale)) {
           ++result->volumes_overlapping_all;
         }
       }
     }
   }
-  result->overlap_rate_all = result->volumes_checked_all > 0
-                                 ? static_cast<double>(result->volumes_overlapping_all) / result->volumes_checked_all
-                                 : 0.0;
-  result->hit_rate_all = result->volumes_checked_all > 0
-                             ? static_cast<double>(result->volumes_hit_all) / result->volumes_checked_all
-                             : 0.0;
+  result->overlap_rate_all = Ratio(result->volumes_overlapping_all, result->volumes_checked_all);
+  result->hit_rate_all = Ratio(result->volumes_hit_all, result->volumes_checked_all);
   result->settled_samples = static_cast<int>(all_rel.size());
   if (!all_rel.empty()) {
     double sum = 0.0;
@@ -314,9 +311,7 @@ Status EvaluateObjects(const std::map<int, ObjectEstimate>& estimates,
     result->rel_error_settled_mean = sum / static_cast<double>(all_rel.size());
   }
   result->volume_ratio_median = MedianOrNegative(all_ratios);
-  result->hit_rate = result->volumes_checked > 0
-                         ? static_cast<double>(result->volumes_hit) / result->volumes_checked
-                         : 0.0;
+  result->hit_rate = Ratio(result->volumes_hit, result->volumes_checked);
   return Status::Ok();
 }
 
