@@ -55,6 +55,7 @@ void BM_TrackingAndSegmentation(benchmark::State& state) {
   TrackerOptions to;
   to.max_features = 1000;
   to.klt_threads = static_cast<int>(state.range(0));  // 1: one core; 2: the service's default
+  to.klt_backend = state.range(1) == 0 ? "mbslam" : "opencv";
   FeatureTracker tracker(to);
   MotionSegmenter segmenter{SegmentationOptions()};
   int64_t index = 0;
@@ -68,7 +69,8 @@ void BM_TrackingAndSegmentation(benchmark::State& state) {
     const Clock::time_point tp = Clock::now();
     // As the service's preprocessing stage: a fresh pyramid every image.
     std::vector<cv::Mat> pyramid;
-    cv::buildOpticalFlowPyramid(frames[static_cast<size_t>(i % 60)], pyramid, cv::Size(21, 21), 3);
+    cv::buildOpticalFlowPyramid(frames[static_cast<size_t>(i % 60)], pyramid, cv::Size(21, 21), 3,
+                                /*withDerivatives=*/to.klt_backend == "opencv");
     const Clock::time_point t0 = Clock::now();
     tracker.TrackFrame(pyramid, i, TrackingHints());
     const Clock::time_point t1 = Clock::now();
@@ -116,8 +118,15 @@ void BM_TrackingAndSegmentation(benchmark::State& state) {
     state.counters["segmentation_ms"] = 1e3 * segmentation_s / static_cast<double>(timed);
   }
 }
-// Argument: KLT threads (1 = everything on one core).
-BENCHMARK(BM_TrackingAndSegmentation)->Arg(1)->Arg(2)->ArgName("klt_threads")->Unit(benchmark::kMillisecond);
+// Arguments: KLT threads (1 = everything on one core); KLT backend (0 = the project's,
+// the default; 1 = OpenCV's calcOpticalFlowPyrLK, for comparison).
+BENCHMARK(BM_TrackingAndSegmentation)
+    ->Args({1, 0})
+    ->Args({2, 0})
+    ->Args({1, 1})
+    ->Args({2, 1})
+    ->ArgNames({"klt_threads", "opencv_klt"})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace mbslam

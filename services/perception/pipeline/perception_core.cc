@@ -476,8 +476,11 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     pyramid_ = std::vector<cv::Mat>();
     // The pyramid's border must hold the KLT window (OpenCV asserts otherwise).
     const int border_win = std::max({21, options_.tracking.klt_window_px, options_.tracking.klt_fast_window_px});
+    // OpenCV's KLT reads derivative levels from the pyramid (or computes them per call);
+    // the project's KLT differentiates its sampled windows and needs none.
     cv::buildOpticalFlowPyramid(frame.gray, pyramid_, cv::Size(border_win, border_win),
-                                options_.preprocess.pyramid_levels - 1);
+                                options_.preprocess.pyramid_levels - 1,
+                                /*withDerivatives=*/options_.tracking.klt_backend == "opencv");
   }
 
   // Tracking, with the previous image's moving hulls as occluders (feedback from

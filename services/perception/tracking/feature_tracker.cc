@@ -13,6 +13,7 @@
 #include "common/util/parallel_for.h"
 #include "services/perception/geometry/patch_warp.h"
 #include "services/perception/geometry/polygon.h"
+#include "services/perception/tracking/klt.h"
 #include "services/perception/tracking/patch_matcher.h"
 
 namespace mbslam {
@@ -49,21 +50,35 @@ int HammingDistance(const uint8_t* a, const uint8_t* b, int bytes) {
   return d;
 }
 
-// Pyramidal KLT (OPTFLOW_USE_INITIAL_FLOW: `next` holds the initial guesses). Every
-// point is tracked independently, so the points are split into `threads` contiguous
-// chunks run concurrently; the result is identical to one call.
+// Pyramidal KLT from the initial guesses in `next`. Every point is tracked independently,
+// so the points are split into `threads` contiguous chunks run concurrently; the result
+// is identical to one call.
 void TrackLk(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
              const std::vector<cv::Point2f>& pts, std::vector<cv::Point2f>* next,
-             std::vector<uint8_t>* status, const cv::Size& win, int max_level,
-             const cv::TermCriteria& term, int threads) {
+             std::vector<uint8_t>* status, int window_px, int max_level, const TrackerOptions& o, int threads) {
+  auto track = [&](const std::vector<cv::Point2f>& p, std::vector<cv::Point2f>* q, std::vector<uint8_t>* st) {
+    if (o.klt_backend == "opencv") {
+      std::vector<float> err;
+      const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, o.klt_max_iterations,
+                                  o.klt_epsilon);
+      cv::calcOpticalFlowPyrLK(from, to, p, *q, *st, err, cv::Size(window_px, window_px), max_level, term,
+                               cv::OPTFLOW_USE_INITIAL_FLOW);
+      return;
+    }
+    KltParams params;
+    params.window_px = window_px;
+    params.max_level = max_level;
+    params.max_iterations = o.klt_max_iterations;
+    params.epsilon_px = o.klt_epsilon;
+    params.min_eigen = o.klt_min_eigen;
+    TrackPointsKlt(from, to, p, q, st, params);
+  };
   const size_t n = pts.size();
   constexpr size_t kMinPointsPerThread = 150;
   const size_t chunks = std::max<size_t>(1, std::min<size_t>(static_cast<size_t>(std::max(1, threads)),
                                                              n / kMinPointsPerThread));
   if (chunks <= 1) {
-    std::vector<float> err;
-    cv::calcOpticalFlowPyrLK(from, to, pts, *next, *status, err, win, max_level, term,
-                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    track(pts, next, status);
     return;
   }
   status->assign(n, 0);
@@ -71,8 +86,7 @@ void TrackLk(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
     std::vector<cv::Point2f> p(pts.begin() + begin, pts.begin() + end);
     std::vector<cv::Point2f> q(next->begin() + begin, next->begin() + end);
     std::vector<uint8_t> st;
-    std::vector<float> err;
-    cv::calcOpticalFlowPyrLK(from, to, p, q, st, err, win, max_level, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+    track(p, &q, &st);
     std::copy(q.begin(), q.end(), next->begin() + begin);
     std::copy(st.begin(), st.end(), status->begin() + begin);
   };
@@ -137,15 +151,11 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   // Stage 1: KLT from the predicted positions, forward then backward.
   stats_.fast_motion = options_.klt_fast_flow_px > 0.0 && last_median_flow_px_ > options_.klt_fast_flow_px;
   const int win_px = stats_.fast_motion ? options_.klt_fast_window_px : options_.klt_window_px;
-  const cv::Size win(win_px, win_px);
-  const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                              options_.klt_max_iterations, options_.klt_epsilon);
   const int max_level = (stats_.fast_motion ? options_.klt_fast_levels : options_.klt_levels) - 1;
   std::vector<uint8_t> status, back_status;
-  std::vector<float> err;
   std::vector<cv::Point2f> back_pts;
   if (!prev_pts.empty()) {
-    TrackLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status, win, max_level, term,
+    TrackLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status, win_px, max_level, options_,
             options_.klt_threads);
     // Wide search: a failed prediction (a body that changed its motion) is retried
     // from the previous position.
@@ -161,9 +171,7 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     }
     if (!retry.empty()) {
       std::vector<uint8_t> rs;
-      std::vector<float> re;
-      cv::calcOpticalFlowPyrLK(prev_pyramid_, pyramid, retry_prev, retry_next, rs, re, win,
-                               max_level, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+      TrackLk(prev_pyramid_, pyramid, retry_prev, &retry_next, &rs, win_px, max_level, options_, 1);
       for (size_t r = 0; r < retry.size(); ++r) {
         if (rs[r]) {
           status[retry[r]] = 1;
@@ -187,8 +195,8 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     }
     if (!found.empty()) {
       std::vector<uint8_t> found_status;
-      TrackLk(pyramid, prev_pyramid_, found_next, &found_back, &found_status, win, options_.klt_backward_levels - 1,
-              term, options_.klt_threads);
+      TrackLk(pyramid, prev_pyramid_, found_next, &found_back, &found_status, win_px,
+              options_.klt_backward_levels - 1, options_, options_.klt_threads);
       for (size_t f = 0; f < found.size(); ++f) {
         back_pts[found[f]] = found_back[f];
         back_status[found[f]] = found_status[f];
@@ -201,6 +209,8 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   const float a = static_cast<float>(options_.velocity_smoothing);
   // Which tracks KLT matched (forward-backward, border, appearance).
   std::vector<uint8_t> matched(prev_pts.size(), 0);
+  // Each patch has its own buffer: map points keep their track's latest patch (a shallow
+  // copy), and a view into one per-image buffer would keep that whole buffer alive.
   std::vector<cv::Mat> patches(prev_pts.size());
   for (size_t k = 0; k < prev_pts.size(); ++k) {
     const Track& t = tracks_[klt_index[k]];

@@ -10,6 +10,7 @@
 // their reference appearance warped into the new view, against KLT's drift).
 
 #include <cstdint>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -42,6 +43,10 @@ struct TrackerOptions {
   int klt_max_iterations = 12;         // KLT iterations per level (count)
   int klt_threads = 2;                 // KLT points split over this many threads (identical result; count)
   double klt_epsilon = 0.05;           // KLT convergence (px)
+  // "mbslam": the project's KLT (klt.h, about a third of OpenCV's cost); "opencv":
+  // cv::calcOpticalFlowPyrLK. Same algorithm; the results differ in the last bits.
+  std::string klt_backend = "mbslam";
+  double klt_min_eigen = 0.1;          // mbslam KLT: untrackable window below this smaller eigenvalue per pixel ((gray / px)^2)
   double max_forward_backward_px = 0.8;  // forward-backward consistency (px)
   double unicity_px = 1.2;             // two tracks closer than this keep only the better (px)
   int max_occluded_frames = 45;        // an occluded track is dropped after this (frames)
@@ -93,6 +98,9 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION_GT(klt_max_iterations, 0);
     MBSLAM_CHECK_OPTION(klt_threads >= 1 && klt_threads <= 16);
     MBSLAM_CHECK_OPTION_GT(klt_epsilon, 0.0);
+    MBSLAM_CHECK_OPTION(klt_backend == "mbslam" || klt_backend == "opencv");
+    MBSLAM_CHECK_OPTION_GE(klt_min_eigen, 0.0);
+    MBSLAM_CHECK_OPTION(klt_window_px % 2 == 1 && klt_fast_window_px % 2 == 1 && klt_fast_window_px <= 63);
     MBSLAM_CHECK_OPTION_GT(max_forward_backward_px, 0.0);
     MBSLAM_CHECK_OPTION_GE(unicity_px, 0.0);
     MBSLAM_CHECK_OPTION_GE(max_occluded_frames, 0);
@@ -137,6 +145,8 @@ struct TrackerOptions {
     v("klt_fast_levels", &klt_fast_levels, "KLT pyramid levels under fast motion (count)");
     v("klt_max_iterations", &klt_max_iterations, "KLT iterations per level (count)");
     v("klt_epsilon", &klt_epsilon, "KLT convergence (px)");
+    v("klt_backend", &klt_backend, "mbslam (the project's KLT, faster) or opencv (cv::calcOpticalFlowPyrLK)");
+    v("klt_min_eigen", &klt_min_eigen, "mbslam KLT: smaller eigenvalue per pixel below which a window is untrackable ((gray/px)^2)");
     v("max_forward_backward_px", &max_forward_backward_px, "forward-backward check (px)");
     v("unicity_px", &unicity_px, "tracks closer than this keep only the better one (px)");
     v("max_occluded_frames", &max_occluded_frames, "occluded tracks dropped after (frames)");

@@ -22,15 +22,20 @@ bool ExtractPatch(const cv::Mat& image, const Eigen::Vector2f& uv, int size, cv:
   return true;
 }
 
-float PatchNcc(const cv::Mat& a, const cv::Mat& b) {
-  if (a.size() != b.size() || a.empty()) return 0.0f;
-  const int n = a.rows * a.cols;
-  double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
-  for (int r = 0; r < a.rows; ++r) {
+namespace {
+
+// Sums of a, b, a^2, b^2 and ab over two 8-bit patches of the same size, in Acc.
+// Continuous patches (the usual case) are summed as one run, which vectorises.
+template <typename Acc>
+void NccSums(const cv::Mat& a, const cv::Mat& b, Acc sums[5]) {
+  Acc sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+  const bool flat = a.isContinuous() && b.isContinuous();
+  const int rows = flat ? 1 : a.rows, cols = flat ? a.rows * a.cols : a.cols;
+  for (int r = 0; r < rows; ++r) {
     const uint8_t* pa = a.ptr<uint8_t>(r);
     const uint8_t* pb = b.ptr<uint8_t>(r);
-    for (int c = 0; c < a.cols; ++c) {
-      const double x = pa[c], y = pb[c];
+    for (int c = 0; c < cols; ++c) {
+      const Acc x = pa[c], y = pb[c];
       sa += x;
       sb += y;
       saa += x * x;
@@ -38,9 +43,29 @@ float PatchNcc(const cv::Mat& a, const cv::Mat& b) {
       sab += x * y;
     }
   }
-  const double va = saa - sa * sa / n, vb = sbb - sb * sb / n;
+  sums[0] = sa, sums[1] = sb, sums[2] = saa, sums[3] = sbb, sums[4] = sab;
+}
+
+}  // namespace
+
+float PatchNcc(const cv::Mat& a, const cv::Mat& b) {
+  if (a.size() != b.size() || a.empty() || a.type() != CV_8UC1 || b.type() != CV_8UC1) return 0.0f;
+  const int n = a.rows * a.cols;
+  // Integer sums are exact, as double sums of the bytes were, and they vectorise; 32 bits
+  // hold them up to 255^2 * 66051 < 2^32 pixels.
+  double s[5];
+  if (n <= 66051) {
+    uint32_t si[5];
+    NccSums(a, b, si);
+    for (int k = 0; k < 5; ++k) s[k] = si[k];
+  } else {
+    uint64_t si[5];
+    NccSums(a, b, si);
+    for (int k = 0; k < 5; ++k) s[k] = static_cast<double>(si[k]);
+  }
+  const double va = s[2] - s[0] * s[0] / n, vb = s[3] - s[1] * s[1] / n;
   if (va < 1e-6 * n || vb < 1e-6 * n) return 0.0f;
-  return static_cast<float>((sab - sa * sb / n) / std::sqrt(va * vb));
+  return static_cast<float>((s[4] - s[0] * s[1] / n) / std::sqrt(va * vb));
 }
 
 PatchMatch FindPatchZssd(const cv::Mat& image, const cv::Mat& patch,
