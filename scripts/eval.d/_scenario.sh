@@ -32,8 +32,9 @@ eval_scenario() {
           --gt-log "$seq/sequence.lcmlog" || echo "{}")
   fi
   if [[ "${ABLATION:-0}" == "1" ]]; then
-    run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/no_feedback" --set slam.use_segmentation=false \
-      --set "objects.camera_height_m=$cam_height"
+    # The same options as the run it is compared with (SERVICE_ARGS), feedback off.
+    run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/no_feedback" --set "objects.camera_height_m=$cam_height" \
+      ${SERVICE_ARGS:-} --set slam.use_segmentation=false
     ate_nf=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/no_feedback/result/camera_trajectory.tum" \
              --gt-sequence "$seq")
   fi
