@@ -117,7 +117,7 @@ MBSLAM_KLT_CLONES void TrackRange(const std::vector<Level>& lf, const std::vecto
         continue;
       }
       SampleBlock<TW>(I, static_cast<int>(fx), static_cast<int>(fy), tx - fx, ty - fy, w + 2, templ);
-      // Gradient (central differences) and the normal matrix, summed per column first:
+      // Gradient (Scharr) and the normal matrix, summed per column first:
       // that vectorises without reordering a float reduction.
       alignas(16) float a11c[WP] = {}, a12c[WP] = {}, a22c[WP] = {};
       // Only the image proper counts: the pyramid's border (a reflection) carries no motion.
