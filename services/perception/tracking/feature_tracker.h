@@ -43,7 +43,7 @@ struct TrackerOptions {
   int klt_max_iterations = 12;         // KLT iterations per level (count)
   int klt_threads = 2;                 // KLT points split over this many threads (identical result; count)
   double klt_epsilon = 0.05;           // KLT convergence (px)
-  // "mbslam": the project's KLT (klt.h, about a third of OpenCV's cost); "opencv":
+  // "mbslam": the project's KLT (klt.h, about half the instructions of OpenCV's); "opencv":
   // cv::calcOpticalFlowPyrLK. Same algorithm; the results differ in the last bits.
   std::string klt_backend = "mbslam";
   double klt_min_eigen = 0.1;          // mbslam KLT: untrackable window below this smaller eigenvalue per pixel ((gray / px)^2)
