@@ -24,6 +24,7 @@ void FeatureTracker::Reset() {
   tracks_.clear();
   recently_lost_.clear();
   prev_pyramid_.clear();
+  prev_klt_pyramid_ = KltPyramid();
   last_rejected_ = false;
   last_median_flow_px_ = 0.0;
 }
@@ -50,18 +51,24 @@ int HammingDistance(const uint8_t* a, const uint8_t* b, int bytes) {
   return d;
 }
 
+// An image's pyramid for KLT: as built (OpenCV's KLT reads it) and as the project's KLT
+// reads it (floats, converted once per image; empty with the OpenCV backend).
+struct LkPyramid {
+  const std::vector<cv::Mat>& bytes;
+  const KltPyramid& floats;
+};
+
 // Pyramidal KLT from the initial guesses in `next`. Every point is tracked independently,
 // so the points are split into `threads` contiguous chunks run concurrently; the result
 // is identical to one call.
-void TrackLk(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
-             const std::vector<cv::Point2f>& pts, std::vector<cv::Point2f>* next,
+void TrackLk(const LkPyramid& from, const LkPyramid& to, const std::vector<cv::Point2f>& pts, std::vector<cv::Point2f>* next,
              std::vector<uint8_t>* status, int window_px, int max_level, const TrackerOptions& o, int threads) {
   auto track = [&](const std::vector<cv::Point2f>& p, std::vector<cv::Point2f>* q, std::vector<uint8_t>* st) {
     if (o.klt_backend == "opencv") {
       std::vector<float> err;
       const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, o.klt_max_iterations,
                                   o.klt_epsilon);
-      cv::calcOpticalFlowPyrLK(from, to, p, *q, *st, err, cv::Size(window_px, window_px), max_level, term,
+      cv::calcOpticalFlowPyrLK(from.bytes, to.bytes, p, *q, *st, err, cv::Size(window_px, window_px), max_level, term,
                                cv::OPTFLOW_USE_INITIAL_FLOW);
       return;
     }
@@ -71,7 +78,7 @@ void TrackLk(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
     params.max_iterations = o.klt_max_iterations;
     params.epsilon_px = o.klt_epsilon;
     params.min_eigen = o.klt_min_eigen;
-    TrackPointsKlt(from, to, p, q, st, params);
+    TrackPointsKlt(from.floats, to.floats, p, q, st, params);
   };
   const size_t n = pts.size();
   constexpr size_t kMinPointsPerThread = 150;
@@ -101,12 +108,16 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   frame_index_ = frame_index;
   recently_lost_.clear();
   const cv::Mat& image = pyramid[0];
+  KltPyramid klt_pyramid;
+  if (options_.klt_backend != "opencv") klt_pyramid = MakeKltPyramid(pyramid);
   if (prev_pyramid_.empty()) {
     tracks_.clear();
     DetectNew(image, frame_index);
     prev_pyramid_ = pyramid;
+    prev_klt_pyramid_ = std::move(klt_pyramid);
     return;
   }
+  const LkPyramid prev_lk{prev_pyramid_, prev_klt_pyramid_}, lk{pyramid, klt_pyramid};
 
   const float border = static_cast<float>(options_.border_px);
   // Nothing in tracks_ changes until the glitch test below has passed (a glitch image
@@ -155,7 +166,7 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   std::vector<uint8_t> status, back_status;
   std::vector<cv::Point2f> back_pts;
   if (!prev_pts.empty()) {
-    TrackLk(prev_pyramid_, pyramid, prev_pts, &next_pts, &status, win_px, max_level, options_,
+    TrackLk(prev_lk, lk, prev_pts, &next_pts, &status, win_px, max_level, options_,
             options_.klt_threads);
     // Wide search: a failed prediction (a body that changed its motion) is retried
     // from the previous position.
@@ -171,7 +182,7 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     }
     if (!retry.empty()) {
       std::vector<uint8_t> rs;
-      TrackLk(prev_pyramid_, pyramid, retry_prev, &retry_next, &rs, win_px, max_level, options_, 1);
+      TrackLk(prev_lk, lk, retry_prev, &retry_next, &rs, win_px, max_level, options_, 1);
       for (size_t r = 0; r < retry.size(); ++r) {
         if (rs[r]) {
           status[retry[r]] = 1;
@@ -195,7 +206,7 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     }
     if (!found.empty()) {
       std::vector<uint8_t> found_status;
-      TrackLk(pyramid, prev_pyramid_, found_next, &found_back, &found_status, win_px,
+      TrackLk(lk, prev_lk, found_next, &found_back, &found_status, win_px,
               options_.klt_backward_levels - 1, options_, options_.klt_threads);
       for (size_t f = 0; f < found.size(); ++f) {
         back_pts[found[f]] = found_back[f];
@@ -329,6 +340,7 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   tracks_ = std::move(next_tracks);
   EnforceUnicity();
   prev_pyramid_ = pyramid;
+  prev_klt_pyramid_ = std::move(klt_pyramid);
   DetectNew(image, frame_index);
 }
 

@@ -19,6 +19,7 @@
 
 #include "common/config/options.h"
 #include "services/perception/geometry/polygon.h"
+#include "services/perception/tracking/klt.h"
 #include "services/perception/tracking/track.h"
 
 namespace mbslam {
@@ -43,7 +44,7 @@ struct TrackerOptions {
   int klt_max_iterations = 12;         // KLT iterations per level (count)
   int klt_threads = 2;                 // KLT points split over this many threads (identical result; count)
   double klt_epsilon = 0.05;           // KLT convergence (px)
-  // "mbslam": the project's KLT (klt.h, about half the instructions of OpenCV's); "opencv":
+  // "mbslam": the project's KLT (klt.h, about a fifth of the instructions of OpenCV's); "opencv":
   // cv::calcOpticalFlowPyrLK. Same algorithm; the results differ in the last bits.
   std::string klt_backend = "mbslam";
   double klt_min_eigen = 0.1;          // mbslam KLT: untrackable window below this smaller eigenvalue per pixel ((gray / px)^2)
@@ -267,6 +268,7 @@ class FeatureTracker {
 
   const TrackerOptions options_;
   std::vector<cv::Mat> prev_pyramid_;
+  KltPyramid prev_klt_pyramid_;  // prev_pyramid_ as the project's KLT reads it (klt.h)
   std::vector<Track> tracks_;
   // Tracks lost in the latest image that guided matching may still recover.
   std::vector<Track> recently_lost_;

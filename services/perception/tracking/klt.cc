@@ -23,28 +23,24 @@
 namespace mbslam {
 namespace {
 
-// One pyramid level: the image and how far outside it the buffer (the pyramid's border)
-// can be read.
+// One pyramid level: the image (grey levels as floats) and how far outside it the buffer
+// (the pyramid's border) can be read.
 struct Level {
-  const uint8_t* origin = nullptr;  // pixel (0, 0)
-  size_t step = 0;
+  const float* origin = nullptr;  // pixel (0, 0)
+  size_t step = 0;                // floats per row
   int x_min = 0, x_max = -1, y_min = 0, y_max = -1;  // readable pixel range, inclusive
   int cols = 0, rows = 0;  // the image proper
 };
 
-std::vector<Level> Levels(const std::vector<cv::Mat>& pyramid) {
-  // With derivatives, cv::buildOpticalFlowPyramid interleaves [image, derivative] per level.
-  const size_t stride = pyramid.size() > 1 && pyramid[1].type() != CV_8UC1 ? 2 : 1;
+std::vector<Level> Levels(const KltPyramid& pyramid) {
   std::vector<Level> levels;
-  for (size_t i = 0; i < pyramid.size(); i += stride) {
-    const cv::Mat& m = pyramid[i];
-    if (m.empty() || m.type() != CV_8UC1) break;
+  for (const cv::Mat& m : pyramid.levels) {
     cv::Size whole;
     cv::Point ofs;
     m.locateROI(whole, ofs);
     Level l;
-    l.origin = m.ptr<uint8_t>(0);
-    l.step = m.step[0];
+    l.origin = m.ptr<float>(0);
+    l.step = m.step[0] / sizeof(float);
     l.x_min = -ofs.x;
     l.y_min = -ofs.y;
     l.x_max = whole.width - ofs.x - 1;
@@ -65,13 +61,12 @@ inline void SampleBlock(const Level& l, int x, int y, float ax, float ay, int ro
   const float w00 = (1.0f - ax) * (1.0f - ay), w01 = ax * (1.0f - ay);
   const float w10 = (1.0f - ax) * ay, w11 = ax * ay;
   for (int r = 0; r < rows; ++r) {
-    const uint8_t* __restrict r0 =
+    const float* __restrict r0 =
         l.origin + static_cast<std::ptrdiff_t>(y + r) * static_cast<std::ptrdiff_t>(l.step) + x;
-    const uint8_t* __restrict r1 = r0 + l.step;
+    const float* __restrict r1 = r0 + l.step;
     float* __restrict o = out + r * C;
     for (int c = 0; c < C; ++c) {
-      o[c] = w00 * static_cast<float>(r0[c]) + w01 * static_cast<float>(r0[c + 1]) +
-             w10 * static_cast<float>(r1[c]) + w11 * static_cast<float>(r1[c + 1]);
+      o[c] = w00 * r0[c] + w01 * r0[c + 1] + w10 * r1[c] + w11 * r1[c + 1];
     }
   }
 }
@@ -209,9 +204,29 @@ MBSLAM_KLT_CLONES void TrackRange(const std::vector<Level>& lf, const std::vecto
 
 }  // namespace
 
-void TrackPointsKlt(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
-                    const std::vector<cv::Point2f>& pts, std::vector<cv::Point2f>* next,
-                    std::vector<uint8_t>* status, const KltParams& params) {
+KltPyramid MakeKltPyramid(const std::vector<cv::Mat>& pyramid) {
+  KltPyramid out;
+  // With derivatives, cv::buildOpticalFlowPyramid interleaves [image, derivative] per level.
+  const size_t stride = pyramid.size() > 1 && pyramid[1].type() != CV_8UC1 ? 2 : 1;
+  for (size_t i = 0; i < pyramid.size(); i += stride) {
+    const cv::Mat& m = pyramid[i];
+    if (m.empty() || m.type() != CV_8UC1) break;
+    // The whole buffer, border included, converted once: grey levels are exact in float,
+    // so sampling the copy gives the bits sampling the bytes gave.
+    cv::Size whole;
+    cv::Point ofs;
+    m.locateROI(whole, ofs);
+    cv::Mat full = m;
+    full.adjustROI(ofs.y, whole.height - ofs.y - m.rows, ofs.x, whole.width - ofs.x - m.cols);
+    cv::Mat f;
+    full.convertTo(f, CV_32F);
+    out.levels.push_back(f(cv::Rect(ofs.x, ofs.y, m.cols, m.rows)));
+  }
+  return out;
+}
+
+void TrackPointsKlt(const KltPyramid& from, const KltPyramid& to, const std::vector<cv::Point2f>& pts,
+                    std::vector<cv::Point2f>* next, std::vector<uint8_t>* status, const KltParams& params) {
   const size_t n = pts.size();
   status->assign(n, 0);
   next->resize(n);
@@ -230,6 +245,12 @@ void TrackPointsKlt(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>
     case 8: TrackRange<32>(lf, lt, top, w, pts, next, status, params); break;
     default: TrackRange<kMaxKltWindow + 1>(lf, lt, top, w, pts, next, status, params); break;
   }
+}
+
+void TrackPointsKlt(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
+                    const std::vector<cv::Point2f>& pts, std::vector<cv::Point2f>* next,
+                    std::vector<uint8_t>* status, const KltParams& params) {
+  TrackPointsKlt(MakeKltPyramid(from), MakeKltPyramid(to), pts, next, status, params);
 }
 
 }  // namespace mbslam

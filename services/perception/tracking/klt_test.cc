@@ -55,6 +55,36 @@ ErrorStats Errors(const std::vector<cv::Point2f>& pts, const std::vector<cv::Poi
   return s;
 }
 
+// The float pyramid is the byte pyramid's grey levels, border included (the same
+// readable range around each level), and skips derivative levels.
+TEST(Klt, FloatPyramidKeepsTheLevelsAndTheirBorder) {
+  const cv::Mat a = Texture(160, 120, 5);
+  for (const bool derivatives : {false, true}) {
+    const std::vector<cv::Mat> bytes = Pyramid(a, 2, derivatives);
+    const KltPyramid floats = MakeKltPyramid(bytes);
+    ASSERT_EQ(floats.levels.size(), 3u) << derivatives;
+    for (size_t l = 0; l < floats.levels.size(); ++l) {
+      const cv::Mat& b = bytes[derivatives ? 2 * l : l];
+      const cv::Mat& f = floats.levels[l];
+      ASSERT_EQ(f.type(), CV_32FC1);
+      ASSERT_EQ(f.size(), b.size());
+      cv::Size bw, fw;
+      cv::Point bo, fo;
+      b.locateROI(bw, bo);
+      f.locateROI(fw, fo);
+      EXPECT_EQ(fw, bw);
+      EXPECT_EQ(fo, bo);
+      cv::Mat bb = b, ff = f;
+      bb.adjustROI(bo.y, bw.height - bo.y - b.rows, bo.x, bw.width - bo.x - b.cols);
+      ff.adjustROI(fo.y, fw.height - fo.y - f.rows, fo.x, fw.width - fo.x - f.cols);
+      cv::Mat converted;
+      bb.convertTo(converted, CV_32F);
+      EXPECT_EQ(cv::norm(converted, ff, cv::NORM_INF), 0.0) << "level " << l;
+    }
+  }
+  EXPECT_TRUE(MakeKltPyramid({}).empty());
+}
+
 TEST(Klt, SubpixelShiftAsAccurateAsOpenCv) {
   const cv::Mat a = Texture(320, 240, 3);
   const cv::Point2f shift(2.3f, -1.7f);
