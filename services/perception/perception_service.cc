@@ -100,6 +100,7 @@ void PerceptionService::MaybePublishStatus() {
   const bool by_wall_time = now_wall - last_status_wall_ >= period && (!from_log_ || now_utime == 0);
   if (!by_message_time && !by_wall_time) return;
   last_status_ = pipeline_->BuildStatus(now_wall);
+  last_status_.results_kept_bytes = recorder_.RetainedBytes();
   lcm_sink_->PublishStatus(last_status_);
   last_status_utime_ = now_utime;
   last_status_wall_ = now_wall;
@@ -133,11 +134,17 @@ Status PerceptionService::Finish() {
   finished_ = true;
   pipeline_->Stop();
   last_status_ = pipeline_->BuildStatus(WallUtime());
+  last_status_.results_kept_bytes = recorder_.RetainedBytes();
   lcm_sink_->PublishStatus(last_status_);
   if (output_log_) output_log_->Flush();
   MBSLAM_LOG(INFO) << "frames received " << last_status_.frames_received << ", processed "
                    << last_status_.frames_processed << ", dropped " << last_status_.frames_dropped
                    << ", rejected " << last_status_.frames_rejected;
+  auto mb = [](int64_t bytes) { return bytes < 0 ? std::string("unknown") : std::to_string(bytes >> 20) + " MB"; };
+  MBSLAM_LOG(INFO) << "memory: resident " << mb(last_status_.memory.rss_bytes) << ", heap in use "
+                   << mb(last_status_.memory.heap_in_use_bytes) << ", heap held "
+                   << mb(last_status_.memory.heap_held_bytes) << ", kept for the output files "
+                   << mb(last_status_.results_kept_bytes);
   for (const auto& [name, value] : last_status_.counters) {
     MBSLAM_LOG(INFO) << "  " << name << ": " << value;
   }

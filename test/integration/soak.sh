@@ -9,8 +9,12 @@
 # Memory may grow only with the map (test/integration/soak_judge.py gives the verdict):
 # in the second half of the run (the steady state) the per-minute minimum of RSS minus
 # the map's high-water mark (per-element costs of the SLAM map, the service's OcTree
-# estimate; the allocator keeps what the map frees) and minus the trajectories kept for
-# the output files must not trend up by more than --max-slope (default 0.5 MB/min).
+# estimate; the allocator keeps what the map frees) and minus what the service keeps for
+# its output files (trajectories, object reconstructions: status_t.results_kept_bytes)
+# must not trend up by more than --max-slope (default 0.5 MB/min, whole minutes only);
+# nor may the C heap in use (status_t.heap_in_use_bytes, glibc's mallinfo2) beyond the
+# current map and the output files: a leak shows there even where the allocator's
+# reuse hides it in the RSS.
 # Whether the map itself is bounded is reported (map_bounded: points in the second half
 # within 10 % of the first half's largest count, the OcTree within its memory bound,
 # occupancy.max_memory_mb). The soak test

@@ -23,11 +23,15 @@ POINT_B, OBSERVATION_B, KEYFRAME_B = 650.0, 48.0, 48.0 * 1024
 def map_mb(r):
     return (float(r["map_points"]) * POINT_B + float(r["map_observations"]) * OBSERVATION_B +
             float(r["map_keyframes"]) * KEYFRAME_B + float(r["occupancy_mem_bytes"])) / MB
-# What the service keeps for its trajectory files (ResultRecorder: 64 B a pose, vectors
-# growing by doubling: 96 B on average), bounded by ResultRecorder::kDefaultMaxPoses.
+# What the service keeps for its output files (ResultRecorder: trajectories and object
+# reconstructions, bounded by ResultRecorder::kDefaultMaxPoses): as it reports it
+# (status_t.results_kept_bytes), or, in older CSVs, estimated from the poses the monitor
+# saw published (64 B a pose, vectors growing by doubling: 96 B on average; this misses
+# the reconstructions' poses and points).
 POSE_B = 96.0
 def trajectory_mb(r):
-    return float(r["trajectory_poses"]) * POSE_B / MB
+    kept = float(r.get("results_kept_mb") or -1.0)
+    return kept if kept >= 0.0 else float(r["trajectory_poses"]) * POSE_B / MB
 t = [float(r["t_s"]) / 60.0 for r in rows]
 rss = [float(r["rss_mb"]) for r in rows]
 
@@ -39,17 +43,34 @@ def fit(xs, ys):
     sxx = sum((x - mx) ** 2 for x in xs)
     return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx if sxx > 0 else None
 
+# The C heap from the service's PERCEPTION_STATUS (absent in older CSVs, -1 when the
+# service cannot tell: sanitizers, another libc): allocated and not freed, and held.
+# Samples before the first status (or without figures) are None.
+def column(name):
+    if not rows or name not in rows[0]:
+        return None
+    v = [float(r[name]) if float(r[name]) >= 0.0 else None for r in rows]
+    return v if any(x is not None for x in v) else None
+heap = column("heap_in_use_mb")
+heap_held = column("heap_held_mb")
+
 # After a warm-up (10 % of the run, at least 1 min): the retained memory is the minimum
 # of each minute (transient peaks -- bundle adjustment, message buffers -- excluded).
+# Whole minutes only: a last, partial minute (the run ends at 20.0 min, one sample in
+# minute 20) has no minimum of a minute, and its one sample would enter the trend with
+# the weight of a minute.
 warm = max(1.0, 0.1 * minutes)
-bins = {}
-for i, r in enumerate(rows):
-    if t[i] < warm:
-        continue
-    b = int(t[i])
-    if b not in bins or rss[i] < rss[bins[b]]:
-        bins[b] = i
-mins = [bins[b] for b in sorted(bins)]
+dt = sorted(t[i + 1] - t[i] for i in range(len(t) - 1))[(len(t) - 1) // 2] if len(t) > 1 else 0.0
+def minute_minima(values):
+    bins = {}
+    for i in range(len(rows)):
+        b = int(t[i])
+        if t[i] < warm or b + 1 > t[-1] + 0.5 * dt or values[i] is None:
+            continue
+        if b not in bins or values[i] < values[bins[b]]:
+            bins[b] = i
+    return [bins[b] for b in sorted(bins)]
+mins = minute_minima(rss)
 slope_raw = fit([t[i] for i in range(len(rows)) if t[i] >= warm], [rss[i] for i in range(len(rows)) if t[i] >= warm])
 slope_min = fit([t[i] for i in mins], [rss[i] for i in mins])
 slope_map = fit([t[i] for i in mins], [map_mb(rows[i]) for i in mins])
@@ -66,6 +87,20 @@ for r in rows:
 # estimates above (allocator fragmentation). The whole run after the warm-up is reported.
 steady = [i for i in mins if t[i] >= t[-1] / 2] if rows else []
 slope_beyond = fit([t[i] for i in steady], [rss[i] - map_high[i] - trajectory_mb(rows[i]) for i in steady])
+# The leak test proper: the heap in use beyond what the map and the trajectories hold now
+# (freed memory leaves the heap in use, so the current map counts, not its high-water
+# mark), per-minute minima in the second half. The RSS above also moves with how the
+# allocator keeps and reuses what was freed (fragmentation, per-thread arenas).
+heap_slope_beyond = heap_slope_beyond_full = heap_held_slope = None
+if heap is not None:
+    hmins = minute_minima(heap)
+    hsteady = [i for i in hmins if t[i] >= t[-1] / 2]
+    beyond = lambda i: heap[i] - map_mb(rows[i]) - trajectory_mb(rows[i])
+    heap_slope_beyond = fit([t[i] for i in hsteady], [beyond(i) for i in hsteady])
+    heap_slope_beyond_full = fit([t[i] for i in hmins], [beyond(i) for i in hmins])
+if heap_held is not None:
+    gmins = [i for i in minute_minima(heap_held) if t[i] >= t[-1] / 2]
+    heap_held_slope = fit([t[i] for i in gmins], [heap_held[i] for i in gmins])
 slope_beyond_full = fit([t[i] for i in mins], [rss[i] - map_high[i] - trajectory_mb(rows[i]) for i in mins])
 # Against the current map size instead (reported, not judged: steps up at every crop).
 slope_beyond_current = fit([t[i] for i in mins], [rss[i] - map_mb(rows[i]) - trajectory_mb(rows[i]) for i in mins])
@@ -92,7 +127,11 @@ r2 = lambda v: None if v is None else round(v, 4)
 # its quarantine (256 MB by default) and every allocation has shadow and redzones, so
 # a 5-minute run grows by hundreds of MB without a leak. There the verdict is
 # LeakSanitizer's; the slopes are printed but not judged.
-slope_ok = asan == 1 or (slope_beyond is not None and slope_beyond <= max_slope)
+# Both must hold: the RSS (what the machine gives up) and, where the service reports it,
+# the heap in use (a leak shows there even when the allocator's reuse hides it in the RSS,
+# and the allocator's churn does not show there).
+heap_ok = heap_slope_beyond is None or heap_slope_beyond <= max_slope
+slope_ok = asan == 1 or (slope_beyond is not None and slope_beyond <= max_slope and heap_ok)
 map_bounded = bool(rows) and bounded("map_points") and occupancy_bounded()
 ok = (alive == 1 and exit_code == 0 and duration >= 0.95 * minutes and frames > 0 and
       slope_ok and map_bounded and (leaks in (None, 0)))
@@ -107,6 +146,11 @@ out = {
     "rss_slope_beyond_map_mb_per_min": r2(slope_beyond),
     "rss_slope_beyond_map_full_run_mb_per_min": r2(slope_beyond_full),
     "rss_slope_beyond_current_map_mb_per_min": r2(slope_beyond_current),
+    "heap_in_use_slope_beyond_map_mb_per_min": r2(heap_slope_beyond),
+    "heap_in_use_slope_beyond_map_full_run_mb_per_min": r2(heap_slope_beyond_full),
+    "heap_held_slope_mb_per_min": r2(heap_held_slope),
+    "heap_in_use_end_mb": None if heap is None or heap[-1] is None else round(heap[-1], 2),
+    "heap_held_end_mb": None if heap_held is None or heap_held[-1] is None else round(heap_held[-1], 2),
     "max_slope_mb_per_min": max_slope,
     "map_mem_end_mb": round(map_mb(rows[-1]), 2) if rows else None,
     "map_points_end": int(rows[-1]["map_points"]) if rows else 0,
@@ -122,7 +166,8 @@ out = {
     "occupancy_mem_growth_mb_per_min_2nd_half": r2(None if growth("occupancy_mem_bytes") is None else growth("occupancy_mem_bytes") / MB),
     "frames": frames, "frames_received": received, "frames_dropped": dropped,
     "service_alive_at_end": bool(alive), "service_exit": exit_code,
-    "asan": bool(asan), "lsan_leaks": leaks, "rss_slope_judged": asan != 1, "passed": ok,
+    "asan": bool(asan), "lsan_leaks": leaks, "rss_slope_judged": asan != 1,
+    "heap_slope_judged": asan != 1 and heap_slope_beyond is not None, "passed": ok,
 }
 print(f"soak ({scenario}, {duration:.1f} min{', ASan/LSan' if asan else ''}): RSS {out['rss_start_mb']} -> "
       f"{out['rss_end_mb']} MB (max {out['rss_max_mb']}); slope {out['rss_slope_mb_per_min']} MB/min, retained "
@@ -131,6 +176,12 @@ print(f"soak ({scenario}, {duration:.1f} min{', ASan/LSan' if asan else ''}): RS
       f"beyond the map's high-water mark {out['rss_slope_beyond_map_mb_per_min']} MB/min in the second half "
       f"({out['rss_slope_beyond_map_full_run_mb_per_min']} over the whole run) "
       f"({'limit ' + str(max_slope) if asan != 1 else 'not judged under ASan: quarantine'})")
+if heap is not None:
+    print(f"  C heap: in use {out['heap_in_use_end_mb']} MB, held {out['heap_held_end_mb']} MB at the end; in use beyond "
+          f"the map and the trajectories {out['heap_in_use_slope_beyond_map_mb_per_min']} MB/min in the second half "
+          f"({out['heap_in_use_slope_beyond_map_full_run_mb_per_min']} over the whole run), held "
+          f"{out['heap_held_slope_mb_per_min']} MB/min in the second half"
+          f"{' (limit ' + str(max_slope) + ')' if asan != 1 else ''}")
 print(f"  map at the end {out['map_mem_end_mb']} MB: {out['map_points_end']} points (max {out['map_points_max']}), "
       f"{out['map_keyframes_max']} keyframes max, OcTree {out['occupancy_mem_mb_end']} MB; second half: points "
       f"{out['map_points_growth_per_min_2nd_half']}/min, OcTree {out['occupancy_mem_growth_mb_per_min_2nd_half']} MB/min; "

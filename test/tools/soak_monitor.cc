@@ -2,7 +2,7 @@
 // /proc/PID/status) and, from its LCM outputs, frames and map size. One CSV line per
 // interval on stdout:
 //   t_s,rss_mb,frames_received,frames_processed,frames_dropped,map_points,map_keyframes,map_observations,
-//   occupancy_bytes,occupancy_mem_bytes,trajectory_poses
+//   occupancy_bytes,occupancy_mem_bytes,trajectory_poses,heap_in_use_mb,heap_held_mb,results_kept_mb
 // map_observations sums keyframe_t.num_observations (point observations held by keyframes).
 // trajectory_poses counts what the service keeps for its trajectory files: tracked camera
 // poses plus tracked / reconstructed object poses (ResultRecorder, 64 B each).
@@ -70,12 +70,16 @@ int main(int argc, char** argv) {
   const mbslam::ChannelOptions ch;
   int64_t received = 0, processed = 0, dropped = 0, points = 0, keyframes = 0, observations = 0;
   int64_t occupancy = 0, occupancy_mem = 0, trajectory_poses = 0;
+  int64_t heap_in_use = -1, heap_held = -1, results_kept = -1;
   bus->Subscribe(ch.perception_status, [&](const std::string&, const uint8_t* d, size_t n, int64_t) {
     mbslam::status_t m{};
     if (!mbslam::DecodeLcmMessage(d, n, &m).ok()) return;
     received = m.frames_received;
     processed = m.frames_processed;
     dropped = m.frames_dropped;
+    heap_in_use = m.heap_in_use_bytes;
+    heap_held = m.heap_held_bytes;
+    results_kept = m.results_kept_bytes;
   });
   bus->Subscribe(ch.perception_map, [&](const std::string&, const uint8_t* d, size_t n, int64_t) {
     mbslam::map_t m{};
@@ -105,7 +109,7 @@ int main(int argc, char** argv) {
     for (const auto& o : m.objects) trajectory_poses += o.state != mbslam::object_t::STATE_DETECTED;
   }, 1000);
   std::printf("t_s,rss_mb,frames_received,frames_processed,frames_dropped,map_points,map_keyframes,map_observations,"
-              "occupancy_bytes,occupancy_mem_bytes,trajectory_poses\n");
+              "occupancy_bytes,occupancy_mem_bytes,trajectory_poses,heap_in_use_mb,heap_held_mb,results_kept_mb\n");
   const int64_t start = mbslam::MonotonicUtime();
   int64_t next = start;
   while (true) {
@@ -113,12 +117,13 @@ int main(int argc, char** argv) {
     if (now >= next) {
       const double rss = RssMb(pid);
       if (rss < 0.0) break;
-      std::printf("%.1f,%.2f,%lld,%lld,%lld,%lld,%lld,%lld,%lld,%lld,%lld\n", mbslam::UtimeToSeconds(now - start), rss,
+      auto mb = [](int64_t bytes) { return bytes < 0 ? -1.0 : static_cast<double>(bytes) / (1024.0 * 1024.0); };
+      std::printf("%.1f,%.2f,%lld,%lld,%lld,%lld,%lld,%lld,%lld,%lld,%lld,%.3f,%.3f,%.3f\n", mbslam::UtimeToSeconds(now - start), rss,
                   static_cast<long long>(received), static_cast<long long>(processed),
                   static_cast<long long>(dropped), static_cast<long long>(points),
                   static_cast<long long>(keyframes), static_cast<long long>(observations),
                   static_cast<long long>(occupancy), static_cast<long long>(occupancy_mem),
-                  static_cast<long long>(trajectory_poses));
+                  static_cast<long long>(trajectory_poses), mb(heap_in_use), mb(heap_held), mb(results_kept));
       std::fflush(stdout);
       if (now - start >= mbslam::SecondsToUtime(seconds)) break;
       next += mbslam::SecondsToUtime(interval);

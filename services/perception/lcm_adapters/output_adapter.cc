@@ -186,6 +186,10 @@ mbslam::status_t ToLcm(const PipelineStatus& s) {
   m.processed_fps = s.processed_fps;
   m.latency_p50_ms = s.latency_p50_ms;
   m.latency_p99_ms = s.latency_p99_ms;
+  m.memory_rss_bytes = s.memory.rss_bytes;
+  m.heap_in_use_bytes = s.memory.heap_in_use_bytes;
+  m.heap_held_bytes = s.memory.heap_held_bytes;
+  m.results_kept_bytes = s.results_kept_bytes;
   m.num_stages = static_cast<int32_t>(s.stages.size());
   for (const StageStatus& st : s.stages) {
     mbslam::stage_timing_t t{};

@@ -267,6 +267,7 @@ PipelineStatus PerceptionPipeline::BuildStatus(int64_t wall_utime) {
   const TimingSummary latency = latency_.Drain();
   s.latency_p50_ms = latency.p50_ms;
   s.latency_p99_ms = latency.p99_ms;
+  s.memory = SampleProcessMemory();
   for (TimingStats* stage : timers_->All()) {
     StageStatus st{stage->name(), stage->Drain()};
     if (st.timing.overruns > 0) counters_->Increment(counter::kStageOverrun, st.timing.overruns);

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "common/util/bounded_queue.h"
+#include "common/util/process_memory.h"
 #include "common/util/timing_stats.h"
 #include "services/perception/pipeline/counters.h"
 #include "services/perception/pipeline/frame_processor.h"
@@ -59,6 +60,8 @@ struct PipelineStatus {
   double processed_fps = 0.0;  // wall time
   double latency_p50_ms = 0.0;
   double latency_p99_ms = 0.0;
+  ProcessMemory memory;        // sampled when built
+  int64_t results_kept_bytes = -1;  // what the output files' recorder holds (set by the service; -1 unknown)
   std::vector<StageStatus> stages;
   std::vector<QueueStatus> queues;
   std::vector<std::pair<std::string, int64_t>> counters;

@@ -80,6 +80,21 @@ int64_t ResultRecorder::frames() const {
   return frames_;
 }
 
+int64_t ResultRecorder::RetainedBytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  // A red-black tree node: three pointers and the colour, then the value.
+  constexpr size_t kTreeNode = 4 * sizeof(void*);
+  size_t bytes = camera_.size() * sizeof(TimedPose);
+  for (const auto& [id, poses] : objects_) {
+    bytes += kTreeNode + sizeof(id) + sizeof(poses) + poses.capacity() * sizeof(TimedPose);
+  }
+  for (const auto& [key, rec] : reconstructions_) {
+    bytes += kTreeNode + sizeof(key) + sizeof(rec) + rec.obj_from_cam.capacity() * sizeof(TimedPose) +
+             rec.points.capacity() * sizeof(Eigen::Vector3f);
+  }
+  return static_cast<int64_t>(bytes);
+}
+
 Status ResultRecorder::Write(const std::string& dir, const std::string& extra_summary) const {
   std::lock_guard<std::mutex> lock(mutex_);
   ::mkdir(dir.c_str(), 0755);

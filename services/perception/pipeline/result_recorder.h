@@ -33,6 +33,12 @@ class ResultRecorder : public OutputSink {
 
   int64_t frames() const;
 
+  // What the recorder's trajectories and object reconstructions hold, from their
+  // containers' sizes and capacities (bytes; the allocator's per-block overhead aside).
+  // It grows with the run up to the pose budget (the latest map and occupancy copies are
+  // bounded with the map and not counted): what a soak test must not take for a leak.
+  int64_t RetainedBytes() const;
+
  private:
   struct TimedPose {
     int64_t utime = 0;  // µs

@@ -114,5 +114,45 @@ TEST(ResultRecorder, TrajectoriesAreBoundedOldestDropped) {
   EXPECT_NE(summary.find("\"frames\": 25"), std::string::npos);
 }
 
+// What the recorder reports holding grows with what it keeps (camera and object poses,
+// reconstructions' poses and points) and falls when the pose budget drops the oldest.
+TEST(ResultRecorder, ReportsWhatItKeeps) {
+  ResultRecorder recorder(/*max_poses=*/100);
+  EXPECT_EQ(recorder.RetainedBytes(), 0);
+  int64_t last = 0;
+  for (int i = 0; i < 40; ++i) {
+    FrameResult r;
+    r.utime = 1000000 + i * 100000;
+    r.camera_pose.utime = r.utime;
+    r.camera_pose.tracking_state = TrackingState::kOk;
+    ObjectReconstructionOutput rec;
+    rec.object_id = 1 + i / 10;
+    rec.map_id = rec.object_id;
+    rec.points_included = true;
+    rec.points.assign(500, Eigen::Vector3f::Ones());
+    r.object_reconstructions.push_back(rec);
+    recorder.OnFrameResult(r);
+    const int64_t now = recorder.RetainedBytes();
+    EXPECT_GE(now, last) << i;
+    last = now;
+  }
+  // 40 camera poses, 40 reconstruction poses and four reconstructions' 500 points each.
+  EXPECT_GE(last, 80 * 64 + 4 * 500 * 12);
+  EXPECT_LT(last, 2 * (80 * 64 + 4 * 500 * 12));
+  // Past the budget (100 object poses), the oldest reconstructions go whole.
+  for (int i = 40; i < 200; ++i) {
+    FrameResult r;
+    r.utime = 1000000 + i * 100000;
+    ObjectReconstructionOutput rec;
+    rec.object_id = 1 + i / 10;
+    rec.map_id = rec.object_id;
+    rec.points_included = true;
+    rec.points.assign(500, Eigen::Vector3f::Ones());
+    r.object_reconstructions.push_back(rec);
+    recorder.OnFrameResult(r);
+  }
+  EXPECT_LT(recorder.RetainedBytes(), 40 * 64 + 100 * 64 * 2 + 11 * (500 * 12 + 256));
+}
+
 }  // namespace
 }  // namespace mbslam
