@@ -72,8 +72,13 @@ struct PerceptionOptions {
     c.map_publish_every_frames = map_publish_every_frames;
     c.objects = objects;
     c.object_slam = object_slam;
-    // Lockstep replays must be deterministic: bundle adjustment runs inline there.
-    if (pipeline.lockstep()) c.slam.background_ba = false;
+    // Lockstep replays must be deterministic: bundle adjustment runs inline there, and
+    // stops on its iteration count, not on wall time (a BA cut at 0.2 s under load gave
+    // another DAVIS result from the same log).
+    if (pipeline.lockstep()) {
+      c.slam.background_ba = false;
+      c.slam.ba.time_limited = false;
+    }
     c.wait_for_person_checks = pipeline.lockstep();
     return c;
   }

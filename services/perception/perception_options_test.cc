@@ -31,5 +31,18 @@ TEST(PerceptionOptions, ConfigFileListsEveryOptionWithItsDefault) {
 
 TEST(PerceptionOptions, DefaultsPassCheck) { EXPECT_TRUE(PerceptionOptions().Check()); }
 
+// A lockstep replay gives the same result on a loaded machine: its bundle adjustments run
+// inline and are bounded by iterations, not wall time. Live, they are time-limited.
+TEST(PerceptionOptions, LockstepBundleAdjustmentIgnoresWallTime) {
+  PerceptionOptions live;
+  EXPECT_TRUE(live.core().slam.ba.time_limited);
+  EXPECT_TRUE(live.core().slam.background_ba);
+  PerceptionOptions replay;
+  replay.pipeline.mode = "lockstep";
+  EXPECT_FALSE(replay.core().slam.ba.time_limited);
+  EXPECT_FALSE(replay.core().slam.background_ba);
+  EXPECT_TRUE(replay.core().wait_for_person_checks);
+}
+
 }  // namespace
 }  // namespace mbslam

@@ -123,7 +123,7 @@ BaSummary SolveBa(BaProblem* p, const BundleAdjustmentOptions& o) {
   options.linear_solver_type = ceres::SPARSE_SCHUR;
   options.linear_solver_ordering = ordering;
   options.max_num_iterations = o.max_iterations;
-  options.max_solver_time_in_seconds = o.max_seconds;
+  if (o.time_limited) options.max_solver_time_in_seconds = o.max_seconds;
   options.num_threads = 1;
   options.minimizer_progress_to_stdout = false;
   options.logging_type = ceres::SILENT;

@@ -23,6 +23,10 @@ struct BundleAdjustmentOptions {
   int window_keyframes = 7;      // keyframes optimised in a local BA (count)
   int max_iterations = 15;       // solver iterations (count)
   double max_seconds = 0.2;      // solver time limit (s)
+  // Live, the solver stops at max_seconds of wall time; a lockstep replay turns this off
+  // (PerceptionOptions::core) so that its result does not depend on how loaded the
+  // machine is: max_iterations alone bounds it there.
+  bool time_limited = true;
   double huber_px = 2.0;         // Huber threshold (px)
   double outlier_px = 4.0;       // observations above this after the BA are removed (px)
   int global_max_keyframes = 40; // a map up to this size gets a global BA after initialisation (count)
@@ -45,6 +49,7 @@ struct BundleAdjustmentOptions {
     v("window_keyframes", &window_keyframes, "keyframes optimised by local BA (count)");
     v("max_iterations", &max_iterations, "solver iterations (count)");
     v("max_seconds", &max_seconds, "solver time limit (s)");
+    v("time_limited", &time_limited, "stop at max_seconds (lockstep replays: off, deterministic)");
     v("huber_px", &huber_px, "Huber threshold (px)");
     v("outlier_px", &outlier_px, "observations above this after BA are removed (px)");
     v("global_max_keyframes", &global_max_keyframes, "maps up to this size get a global BA (count)");
