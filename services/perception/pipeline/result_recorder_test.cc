@@ -119,19 +119,23 @@ TEST(ResultRecorder, TrajectoriesAreBoundedOldestDropped) {
 TEST(ResultRecorder, ReportsWhatItKeeps) {
   ResultRecorder recorder(/*max_poses=*/100);
   EXPECT_EQ(recorder.RetainedBytes(), 0);
-  int64_t last = 0;
-  for (int i = 0; i < 40; ++i) {
+  // Image i: a reconstruction of object 1 + i / 10 with 500 points, and a camera pose.
+  auto image = [](int i, bool tracked) {
     FrameResult r;
     r.utime = 1000000 + i * 100000;
     r.camera_pose.utime = r.utime;
-    r.camera_pose.tracking_state = TrackingState::kOk;
+    r.camera_pose.tracking_state = tracked ? TrackingState::kOk : TrackingState::kLost;
     ObjectReconstructionOutput rec;
     rec.object_id = 1 + i / 10;
     rec.map_id = rec.object_id;
     rec.points_included = true;
     rec.points.assign(500, Eigen::Vector3f::Ones());
     r.object_reconstructions.push_back(rec);
-    recorder.OnFrameResult(r);
+    return r;
+  };
+  int64_t last = 0;
+  for (int i = 0; i < 40; ++i) {
+    recorder.OnFrameResult(image(i, true));
     const int64_t now = recorder.RetainedBytes();
     EXPECT_GE(now, last) << i;
     last = now;
@@ -140,17 +144,7 @@ TEST(ResultRecorder, ReportsWhatItKeeps) {
   EXPECT_GE(last, 80 * 64 + 4 * 500 * 12);
   EXPECT_LT(last, 2 * (80 * 64 + 4 * 500 * 12));
   // Past the budget (100 object poses), the oldest reconstructions go whole.
-  for (int i = 40; i < 200; ++i) {
-    FrameResult r;
-    r.utime = 1000000 + i * 100000;
-    ObjectReconstructionOutput rec;
-    rec.object_id = 1 + i / 10;
-    rec.map_id = rec.object_id;
-    rec.points_included = true;
-    rec.points.assign(500, Eigen::Vector3f::Ones());
-    r.object_reconstructions.push_back(rec);
-    recorder.OnFrameResult(r);
-  }
+  for (int i = 40; i < 200; ++i) recorder.OnFrameResult(image(i, false));
   EXPECT_LT(recorder.RetainedBytes(), 40 * 64 + 100 * 64 * 2 + 11 * (500 * 12 + 256));
 }
 

@@ -61,15 +61,16 @@ struct LkPyramid {
 // Pyramidal KLT from the initial guesses in `next`. Every point is tracked independently,
 // so the points are split into `threads` contiguous chunks run concurrently; the result
 // is identical to one call.
-void TrackLk(const LkPyramid& from, const LkPyramid& to, const std::vector<cv::Point2f>& pts, std::vector<cv::Point2f>* next,
-             std::vector<uint8_t>* status, int window_px, int max_level, const TrackerOptions& o, int threads) {
+void TrackLk(const LkPyramid& from, const LkPyramid& to, const std::vector<cv::Point2f>& pts,
+             std::vector<cv::Point2f>* next, std::vector<uint8_t>* status, int window_px, int max_level,
+             const TrackerOptions& o, int threads) {
   auto track = [&](const std::vector<cv::Point2f>& p, std::vector<cv::Point2f>* q, std::vector<uint8_t>* st) {
     if (o.klt_backend == "opencv") {
       std::vector<float> err;
       const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, o.klt_max_iterations,
                                   o.klt_epsilon);
-      cv::calcOpticalFlowPyrLK(from.bytes, to.bytes, p, *q, *st, err, cv::Size(window_px, window_px), max_level, term,
-                               cv::OPTFLOW_USE_INITIAL_FLOW);
+      cv::calcOpticalFlowPyrLK(from.bytes, to.bytes, p, *q, *st, err, cv::Size(window_px, window_px), max_level,
+                               term, cv::OPTFLOW_USE_INITIAL_FLOW);
       return;
     }
     KltParams params;
