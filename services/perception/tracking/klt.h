@@ -5,7 +5,7 @@
 // Gauss-Newton steps move the window in the second image until the step is below epsilon.
 //
 // The same algorithm as OpenCV's calcOpticalFlowPyrLK, at about a fifth of its
-// instructions (frontend_bench under callgrind, 21 images: 454 M, the float conversion
+// instructions (frontend_bench under callgrind, 21 images: 428 M, the float conversion
 // included, against 2,371 M): the window sits at one sub-pixel offset, so bilinear
 // sampling is a 2x2 filter with constant weights over contiguous rows of floats (the
 // pyramid converted once per image, KltPyramid), and the row loops run over a
