@@ -19,7 +19,7 @@
 
 namespace mbslam {
 
-ProcessMemory SampleProcessMemory() {
+ProcessMemory SampleProcessMemory(bool with_heap) {
   ProcessMemory m;
   // statm: size resident shared text lib data dt, in pages.
   if (FILE* f = std::fopen("/proc/self/statm", "r")) {
@@ -31,9 +31,11 @@ ProcessMemory SampleProcessMemory() {
   }
 #if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33)) && \
     !defined(MBSLAM_ASAN_ALLOCATOR)
-  const struct mallinfo2 mi = mallinfo2();
-  m.heap_in_use_bytes = static_cast<int64_t>(mi.uordblks + mi.hblkhd);
-  m.heap_held_bytes = static_cast<int64_t>(mi.arena + mi.hblkhd);
+  if (with_heap) {
+    const struct mallinfo2 mi = mallinfo2();
+    m.heap_in_use_bytes = static_cast<int64_t>(mi.uordblks + mi.hblkhd);
+    m.heap_held_bytes = static_cast<int64_t>(mi.arena + mi.hblkhd);
+  }
 #endif
   return m;
 }

@@ -267,7 +267,17 @@ PipelineStatus PerceptionPipeline::BuildStatus(int64_t wall_utime) {
   const TimingSummary latency = latency_.Drain();
   s.latency_p50_ms = latency.p50_ms;
   s.latency_p99_ms = latency.p99_ms;
-  s.memory = SampleProcessMemory();
+  // The heap figures at most every heap_stats_period_us (mallinfo2 holds the allocator's
+  // locks); in between, the last ones with a fresh resident set.
+  const bool heap_due = options_.heap_stats_period_us > 0 &&
+                        (heap_sampled_wall_ == 0 || wall_utime - heap_sampled_wall_ >= options_.heap_stats_period_us);
+  const ProcessMemory now = SampleProcessMemory(heap_due);
+  if (heap_due) {
+    memory_ = now;
+    heap_sampled_wall_ = wall_utime;
+  }
+  memory_.rss_bytes = now.rss_bytes;
+  s.memory = memory_;
   for (TimingStats* stage : timers_->All()) {
     StageStatus st{stage->name(), stage->Drain()};
     if (st.timing.overruns > 0) counters_->Increment(counter::kStageOverrun, st.timing.overruns);

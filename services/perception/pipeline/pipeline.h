@@ -144,6 +144,8 @@ class PerceptionPipeline {
 
   // Period bookkeeping for rates (BuildStatus caller's thread only).
   int64_t period_start_wall_ = 0;
+  ProcessMemory memory_;          // the latest figures for PERCEPTION_STATUS
+  int64_t heap_sampled_wall_ = 0;  // when the heap figures were taken (wall µs; 0 = never)
   int64_t period_start_processed_ = 0;
   int64_t period_start_received_ = 0;
   int64_t period_first_utime_ = 0;

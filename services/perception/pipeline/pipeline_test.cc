@@ -162,6 +162,35 @@ TEST(Pipeline, StatusReportsStagesQueuesAndDegradation) {
   EXPECT_TRUE(counted);
 }
 
+// The resident set at every status; the heap figures (mallinfo2, which holds the
+// allocator's locks) at most every heap_stats_period_us, and never with 0.
+TEST(Pipeline, StatusSamplesTheHeapAtItsOwnPeriod) {
+  PipelineOptions options;
+  options.heap_stats_period_us = 10000000;
+  RecordingProcessor processor;
+  CountingSink sink;
+  Counters counters;
+  StageTimers timers;
+  PerceptionPipeline pipeline(options, &processor, &sink, &counters, &timers);
+  const PipelineStatus first = pipeline.BuildStatus(1000000);
+  EXPECT_GT(first.memory.rss_bytes, 0);
+  if (first.memory.heap_in_use_bytes < 0) GTEST_SKIP() << "no glibc heap figures in this build";
+  std::vector<char> grown(size_t{64} << 20, 1);  // 64 MB more in use
+  const PipelineStatus within = pipeline.BuildStatus(5000000);
+  EXPECT_EQ(within.memory.heap_in_use_bytes, first.memory.heap_in_use_bytes);  // not sampled again
+  EXPECT_GT(within.memory.rss_bytes, first.memory.rss_bytes + (int64_t{32} << 20));  // fresh
+  const PipelineStatus after = pipeline.BuildStatus(11000000);
+  EXPECT_GT(after.memory.heap_in_use_bytes, first.memory.heap_in_use_bytes + (int64_t{60} << 20));
+
+  options.heap_stats_period_us = 0;
+  PerceptionPipeline never(options, &processor, &sink, &counters, &timers);
+  const PipelineStatus off = never.BuildStatus(1000000);
+  EXPECT_GT(off.memory.rss_bytes, 0);
+  EXPECT_EQ(off.memory.heap_in_use_bytes, -1);
+  EXPECT_EQ(off.memory.heap_held_bytes, -1);
+  EXPECT_GT(grown.back(), 0);
+}
+
 TEST(Pipeline, LockstepNewTimelineStartsOverThenWaitsForItsOwnOdometry) {
   PipelineOptions options;
   options.mode = "lockstep";
