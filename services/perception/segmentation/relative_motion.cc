@@ -163,8 +163,9 @@ Rigid3d RefineMotion(const Rigid3d& initial, const std::vector<Eigen::Vector2d>&
 // cv::recoverPose's own test (DLT triangulation) confirms the choice; once the screen
 // counts 128 or more, on an evenly spaced sample of 64 inliers (triangulating them all
 // cost 5 M instructions per image, a tenth of the front end, for a count that is only
-// held against min_points), and the count is the screen's. Otherwise (near-degenerate geometry, or the screen and the triangulation
-// disagree) cv::recoverPose itself decides, and its count is returned.
+// held against min_points), and the count is the screen's. Otherwise (near-degenerate
+// geometry, or the screen and the triangulation disagree) cv::recoverPose itself decides,
+// and its count is returned.
 int PoseFromEssential(const cv::Mat& E, const std::vector<cv::Point2d>& pr, const std::vector<cv::Point2d>& pn,
                       const cv::Mat& mask, Eigen::Matrix3d* R, Eigen::Vector3d* t) {
   constexpr double max_depth = 50.0;  // cv::recoverPose's distance threshold (baselines)
