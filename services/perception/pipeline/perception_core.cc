@@ -718,8 +718,12 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   std::map<int, ObjectReconstructionResult> reconstruction_of;  // by segment id
   if (options_.object_slam.enabled) {
     ScopedStageTimer timer(object_slam_timer_);
+    std::optional<CameraRotationPrior> world_rotation;
+    if (slam_pose.valid && slam_pose.state == SlamState::kTracking) {
+      world_rotation = CameraRotationPrior{slam_pose.cam_from_world.rotation, slam_.map_generation()};
+    }
     for (ObjectReconstructionResult& r : object_reconstruction_->Update(
-             frame_index_, frame.utime, 0.5 * (intrinsics.fx + intrinsics.fy), object_tracks)) {
+             frame_index_, frame.utime, 0.5 * (intrinsics.fx + intrinsics.fy), object_tracks, world_rotation)) {
       reconstruction_of[r.id] = std::move(r);
     }
   }

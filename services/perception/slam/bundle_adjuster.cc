@@ -1,6 +1,7 @@
 #include "services/perception/slam/bundle_adjuster.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <set>
 
 #include <ceres/ceres.h>
@@ -38,6 +39,8 @@ BaProblem ExtractBaProblem(const Map& map, int window, bool global, double focal
         pose.fixed = k->fixed || !window_ids.count(o.keyframe_id);
         pose.has_odometry = k->has_odometry;
         pose.odom_from_cam = k->odom_from_cam;
+        pose.utime = k->utime;
+        pose.rotation_prior = k->rotation_prior;
         p.keyframes[o.keyframe_id] = pose;
       }
       p.observations.push_back(BaProblem::Obs{o.keyframe_id, pid, o.xy});
@@ -114,6 +117,25 @@ BaSummary SolveBa(BaProblem* p, const BundleAdjustmentOptions& o) {
         const double sigma = o.odometry_sigma_floor_m + o.odometry_sigma_per_m * d.norm();
         problem.AddResidualBlock(CreateOdometryTranslationPrior(d, sigma), nullptr, q_ptr(prev_id),
                                  t_ptr(prev_id), q_ptr(id), t_ptr(id));
+      }
+      prev = &pose;
+      prev_id = id;
+    }
+  }
+  if (p->rotation_prior_floor_rad > 0.0 || p->rotation_prior_rad_per_s > 0.0) {
+    // Consecutive keyframes (in id order) with rotation priors of the same reference.
+    const BaProblem::Pose* prev = nullptr;
+    int64_t prev_id = -1;
+    for (const auto& [id, pose] : p->keyframes) {
+      if (!pose.rotation_prior) continue;
+      if (prev != nullptr && prev->rotation_prior->ref_id == pose.rotation_prior->ref_id &&
+          !(prev->fixed && pose.fixed)) {
+        const Eigen::Quaterniond b_from_a =
+            pose.rotation_prior->cam_from_ref * prev->rotation_prior->cam_from_ref.conjugate();
+        const double dt_s = 1e-6 * static_cast<double>(std::abs(pose.utime - prev->utime));
+        const double sigma = p->rotation_prior_floor_rad + p->rotation_prior_rad_per_s * dt_s;
+        problem.AddResidualBlock(CreateRelativeRotationPrior(b_from_a, sigma), nullptr, q_ptr(prev_id),
+                                 q_ptr(id));
       }
       prev = &pose;
       prev_id = id;

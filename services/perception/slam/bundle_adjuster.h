@@ -4,11 +4,13 @@
 // Ceres bundle adjustment over a snapshot of part of a map, so that it can run in a
 // back-end thread while the front end keeps tracking; the result is merged back.
 // Huber loss on pixel reprojection errors, explicit Schur ordering (points first),
-// optional odometry translation priors (metric scale), and the solver summary
-// decides whether the result is used.
+// optional odometry translation priors (metric scale), optional relative rotation
+// priors (an object's SLAM: the object barely turns while the camera's own rotation is
+// known), and the solver summary decides whether the result is used.
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -65,6 +67,8 @@ struct BaProblem {
     bool fixed = false;
     bool has_odometry = false;
     Rigid3d odom_from_cam;
+    int64_t utime = 0;
+    std::optional<CameraRotationPrior> rotation_prior;
   };
   std::map<int64_t, Pose> keyframes;
   std::map<int64_t, Eigen::Vector3d> points;
@@ -76,6 +80,11 @@ struct BaProblem {
   std::vector<Obs> observations;
   double focal_px = 1.0;
   bool use_odometry = false;
+  // Relative rotation priors between consecutive keyframes that carry a rotation prior of
+  // the same reference: R_b R_a^T = P_b P_a^T within sigma = floor + rate * |t_b - t_a|
+  // (the body's angular speed in the reference frame); both 0 = none.
+  double rotation_prior_floor_rad = 0.0;
+  double rotation_prior_rad_per_s = 0.0;
 };
 
 struct BaSummary {

@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
 
+#include <ceres/cost_function.h>
+
+#include "services/perception/slam/cost_functions/reprojection_error.h"
 #include "services/perception/slam/triangulation.h"
 
 namespace mbslam {
@@ -61,6 +65,31 @@ TEST(BundleAdjuster, LocalBaReducesErrorAndKeepsGauge) {
   EXPECT_LT(after, 0.6);
   // The fixed keyframe did not move.
   EXPECT_LT(TranslationDistance(map.keyframe(0)->cam_from_world, truth[0]), 1e-12);
+}
+
+// The relative rotation prior: zero when keyframe b's rotation from a matches the
+// expected one, the angle error over sigma otherwise (either sign of the quaternions).
+TEST(BundleAdjuster, RelativeRotationPriorResidual) {
+  const Eigen::Quaterniond qa(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
+  const Eigen::Quaterniond b_from_a(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()));
+  const double sigma = 0.01;
+  std::unique_ptr<ceres::CostFunction> cost(CreateRelativeRotationPrior(b_from_a, sigma));
+  auto residual = [&](const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+    const double pa[4] = {a.x(), a.y(), a.z(), a.w()};
+    const double pb[4] = {b.x(), b.y(), b.z(), b.w()};
+    const double* params[2] = {pa, pb};
+    Eigen::Vector3d r;
+    EXPECT_TRUE(cost->Evaluate(params, r.data(), nullptr));
+    return r;
+  };
+  const Eigen::Quaterniond qb = b_from_a * qa;
+  EXPECT_LT(residual(qa, qb).norm(), 1e-12);
+  const Eigen::Quaterniond neg(-qb.w(), -qb.x(), -qb.y(), -qb.z());
+  EXPECT_LT(residual(qa, neg).norm(), 1e-12);
+  const Eigen::Quaterniond off = Eigen::Quaterniond(Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitZ())) * qb;
+  const Eigen::Vector3d r = residual(qa, off);
+  EXPECT_NEAR(r.norm(), 0.02 / sigma, 1e-3);
+  EXPECT_NEAR(r.z(), 0.02 / sigma, 1e-3);
 }
 
 }  // namespace

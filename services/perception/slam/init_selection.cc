@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include <opencv2/calib3d.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include "services/perception/geometry/polygon.h"
+#include "services/perception/geometry/rigid3.h"
 
 namespace mbslam {
 
@@ -112,6 +116,84 @@ int SelectStaticGroup(const std::vector<InitMotionGroup>& groups, double min_cov
         (g.coverage == groups[static_cast<size_t>(best)].coverage && g.count > groups[static_cast<size_t>(best)].count)) {
       best = static_cast<int>(i);
     }
+  }
+  return best;
+}
+
+namespace {
+
+// Sampson distance of x0 <-> x1 under E (normalised coordinates).
+double SampsonDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& x0, const Eigen::Vector2d& x1) {
+  const Eigen::Vector3d a = x0.homogeneous();
+  const Eigen::Vector3d b = x1.homogeneous();
+  const Eigen::Vector3d Ea = E * a;
+  const Eigen::Vector3d Etb = E.transpose() * b;
+  const double num = b.dot(Ea);
+  const double den = Ea.head<2>().squaredNorm() + Etb.head<2>().squaredNorm();
+  return den > 0.0 ? std::abs(num) / std::sqrt(den) : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+std::optional<KnownRotationTranslation> TranslationGivenRotation(const std::vector<Eigen::Vector2d>& x0,
+                                                                 const std::vector<Eigen::Vector2d>& x1,
+                                                                 const Eigen::Matrix3d& R, double threshold,
+                                                                 int iterations) {
+  const size_t n = std::min(x0.size(), x1.size());
+  if (n < 2) return std::nullopt;
+  std::vector<Eigen::Vector3d> normals(n);
+  for (size_t i = 0; i < n; ++i) normals[i] = (R * x0[i].homogeneous()).cross(x1[i].homogeneous());
+  auto score = [&](const Eigen::Vector3d& t, std::vector<uint8_t>* mask) {
+    const Eigen::Matrix3d E = Hat(t) * R;
+    int c = 0;
+    mask->assign(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+      if (SampsonDistance(E, x0[i], x1[i]) <= threshold) {
+        (*mask)[i] = 1;
+        ++c;
+      }
+    }
+    return c;
+  };
+  std::mt19937 rng(12345);
+  std::uniform_int_distribution<size_t> pick(0, n - 1);
+  KnownRotationTranslation best;
+  std::vector<uint8_t> mask;
+  for (int it = 0; it < iterations; ++it) {
+    const size_t i = pick(rng);
+    const size_t j = pick(rng);
+    if (i == j) continue;
+    const Eigen::Vector3d t = normals[i].cross(normals[j]);
+    if (t.norm() < 1e-12) continue;
+    const int c = score(t.normalized(), &mask);
+    if (c > best.count) {
+      best.count = c;
+      best.t_unit = t.normalized();
+      best.inliers = mask;
+    }
+  }
+  if (best.count < 2) return std::nullopt;
+  // Least squares on the inliers, |t| = 1: the epipolar residual n_i . t over its Sampson
+  // gradient norm at the current t (iteratively reweighted).
+  for (int round = 0; round < 4; ++round) {
+    const Eigen::Matrix3d E = Hat(best.t_unit) * R;
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      if (!best.inliers[i]) continue;
+      const Eigen::Vector3d Ea = E * x0[i].homogeneous();
+      const Eigen::Vector3d Etb = E.transpose() * x1[i].homogeneous();
+      const double den = Ea.head<2>().squaredNorm() + Etb.head<2>().squaredNorm();
+      if (den > 1e-12) A += normals[i] * normals[i].transpose() / den;
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(A);
+    if (eig.info() != Eigen::Success) break;
+    Eigen::Vector3d t = eig.eigenvectors().col(0).normalized();
+    if (t.dot(best.t_unit) < 0.0) t = -t;
+    const int c = score(t, &mask);
+    if (c < best.count) break;
+    best.count = c;
+    best.t_unit = t;
+    best.inliers = mask;
   }
   return best;
 }

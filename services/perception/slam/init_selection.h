@@ -12,6 +12,7 @@
 // hulls is never chosen.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -45,6 +46,23 @@ void ScoreMotionGroups(const std::vector<Eigen::Vector2d>& xn, const std::vector
 // The static world's group: the broadest coverage (ties: more members) among the groups
 // with coverage >= min_coverage and hull_share <= max_hull_share; -1 if none qualifies.
 int SelectStaticGroup(const std::vector<InitMotionGroup>& groups, double min_coverage, double max_hull_share);
+
+// Two views whose relative rotation is known (cam1_from_cam0 = R, e.g. an object's SLAM
+// given the camera's own rotation): the translation direction t is then the only unknown,
+// with x1 . (t x R x0) = 0, i.e. t orthogonal to n = (R x0) x x1 for every
+// correspondence. Two-point RANSAC (t = n_i x n_j), inliers by the Sampson distance of
+// E = [t]x R under `threshold` (normalised units), refined by least squares on the
+// inliers. The sign of t is left open (cheirality decides). Deterministic (fixed seed).
+// nullopt when fewer than 2 inliers or degenerate.
+struct KnownRotationTranslation {
+  Eigen::Vector3d t_unit = Eigen::Vector3d::Zero();
+  std::vector<uint8_t> inliers;
+  int count = 0;
+};
+std::optional<KnownRotationTranslation> TranslationGivenRotation(const std::vector<Eigen::Vector2d>& x0,
+                                                                 const std::vector<Eigen::Vector2d>& x1,
+                                                                 const Eigen::Matrix3d& cam1_from_cam0,
+                                                                 double threshold, int iterations);
 
 }  // namespace mbslam
 

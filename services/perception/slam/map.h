@@ -7,16 +7,29 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
 
 #include "common/util/status.h"
 #include "services/perception/geometry/rigid3.h"
 
 namespace mbslam {
+
+// A rotation that the mapped body keeps nearly constant relative to another frame, given
+// per image: for a moving object's SLAM, the static world SLAM's camera rotation
+// (cam_from_world of the world map). A body that does not turn in that frame has
+// R_cam_b_from_body * R_cam_a_from_body^T = R_cam_b_from_ref * R_cam_a_from_ref^T between any
+// two images a, b; priors are compared only within one reference (ref_id: a new world map
+// is a new reference).
+struct CameraRotationPrior {
+  Eigen::Quaterniond cam_from_ref = Eigen::Quaterniond::Identity();
+  int64_t ref_id = 0;
+};
 
 struct Observation {
   int64_t keyframe_id = 0;
@@ -48,6 +61,7 @@ struct Keyframe {
   std::vector<int64_t> point_ids;   // points observed in this keyframe
   bool has_odometry = false;
   Rigid3d odom_from_cam;            // from interpolated odometry, when available (metric)
+  std::optional<CameraRotationPrior> rotation_prior;  // when the images carry one (object SLAMs)
 };
 
 class Map {

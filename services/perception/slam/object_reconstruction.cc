@@ -37,6 +37,8 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   s.init_min_parallax_deg = options.init_min_parallax_deg;
   s.min_tracking_inliers = options.min_tracking_inliers;
   s.max_keyframes = options.max_keyframes;
+  s.keyframe_max_frames = std::max(options.keyframe_max_frames, s.keyframe_min_frames);
+  s.keyframe_parallax_deg = options.keyframe_parallax_deg;
   // The object is the only motion its SLAM is given, and it covers a small part of the
   // image: no motion selection, no coverage or hull tests.
   s.init_max_motions = 1;
@@ -53,6 +55,9 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   s.use_segmentation = true;
   s.map_load_path.clear();
   s.map_save_path.clear();
+  s.rotation_prior_floor_rad = options.rotation_prior_floor_rad;
+  s.rotation_prior_rad_per_s = options.rotation_prior_rad_per_s;
+  s.rotation_prior_min_inlier_ratio = options.rotation_prior_min_inlier_ratio;
   return s;
 }
 
@@ -67,7 +72,8 @@ void ObjectReconstruction::Flush() {
 
 std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t frame_index, int64_t utime,
                                                                      double focal_px,
-                                                                     const std::vector<ObjectTracksInput>& objects) {
+                                                                     const std::vector<ObjectTracksInput>& objects,
+                                                                     const std::optional<CameraRotationPrior>& world_rotation) {
   std::vector<ObjectReconstructionResult> results;
   if (!options_.enabled || options_.max_objects == 0) return results;
   // Forget the reconstructions of objects gone for a while.
@@ -105,6 +111,7 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
     frame.frame_index = frame_index;
     frame.utime = utime;
     frame.focal_px = focal_px;
+    frame.rotation_prior = world_rotation;
     std::unordered_map<int64_t, int> labels;
     frame.observations.reserve(o->track_ids.size());
     for (size_t i = 0; i < o->track_ids.size() && i < o->xy.size(); ++i) {

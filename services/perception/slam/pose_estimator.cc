@@ -11,9 +11,15 @@ namespace mbslam {
 
 Rigid3d RefinePose(const Rigid3d& initial, const std::vector<Eigen::Vector3d>& X,
                    const std::vector<Eigen::Vector2d>& xy, const std::vector<uint8_t>& use,
-                   double focal, double huber_px, int iterations, Matrix6d* information) {
+                   double focal, double huber_px, int iterations, Matrix6d* information,
+                   const PoseRotationPrior* rotation_prior, double sigma_px) {
   Rigid3d T = initial;
   const double huber = huber_px / focal;
+  const Eigen::Matrix3d prior_target_t =
+      rotation_prior ? Eigen::Matrix3d(rotation_prior->cam_from_world.toRotationMatrix().transpose())
+                     : Eigen::Matrix3d::Identity();
+  const double prior_weight =
+      rotation_prior ? std::pow(sigma_px / (focal * rotation_prior->sigma_rad), 2) : 0.0;
   Matrix6d H = Matrix6d::Zero();
   for (int iter = 0; iter < iterations; ++iter) {
     H.setZero();
@@ -32,6 +38,13 @@ Rigid3d RefinePose(const Rigid3d& initial, const std::vector<Eigen::Vector3d>& X
       ++n;
     }
     if (n < 3) break;
+    if (rotation_prior) {
+      // r = Log(R target^T); under R' = Exp(w) R, dr/dw = J_l^-1(r).
+      const Eigen::Vector3d r = LogSO3(T.RotationMatrix() * prior_target_t);
+      const Eigen::Matrix3d Jr = LeftJacobianInverseSO3(r);
+      H.block<3, 3>(3, 3) += prior_weight * Jr.transpose() * Jr;
+      g.tail<3>() += prior_weight * Jr.transpose() * r;
+    }
     const Vector6d delta = H.ldlt().solve(-g);
     if (!delta.allFinite()) break;
     T = Rigid3d::Exp(delta) * T;
@@ -43,7 +56,9 @@ Rigid3d RefinePose(const Rigid3d& initial, const std::vector<Eigen::Vector3d>& X
 
 PoseEstimate EstimatePose(const std::vector<Eigen::Vector3d>& X, const std::vector<Eigen::Vector2d>& xy,
                           double focal, const std::optional<Rigid3d>& prior,
-                          const PoseEstimatorOptions& o) {
+                          const PoseEstimatorOptions& o,
+                          const std::optional<PoseRotationPrior>& rotation_prior) {
+  const PoseRotationPrior* rp = rotation_prior ? &*rotation_prior : nullptr;
   PoseEstimate out;
   const size_t n = X.size();
   if (n < 6) return out;
@@ -65,7 +80,8 @@ PoseEstimate EstimatePose(const std::vector<Eigen::Vector3d>& X, const std::vect
   if (prior) {
     // Refine the prediction on all correspondences first (robust), then check it.
     std::vector<uint8_t> all(n, 1);
-    const Rigid3d refined = RefinePose(*prior, X, xy, all, focal, o.huber_px, o.refine_iterations, nullptr);
+    const Rigid3d refined = RefinePose(*prior, X, xy, all, focal, o.huber_px, o.refine_iterations, nullptr, rp,
+                                        o.sigma_px);
     const int c = count_inliers(refined, o.ransac_threshold_px, &mask);
     if (c >= o.prior_inlier_ratio * static_cast<double>(n)) {
       T = refined;
@@ -97,7 +113,7 @@ PoseEstimate EstimatePose(const std::vector<Eigen::Vector3d>& X, const std::vect
   }
   Matrix6d info;
   for (int round = 0; round < 2; ++round) {
-    T = RefinePose(T, X, xy, mask, focal, o.huber_px, o.refine_iterations, &info);
+    T = RefinePose(T, X, xy, mask, focal, o.huber_px, o.refine_iterations, &info, rp, o.sigma_px);
     count_inliers(T, o.inlier_px, &mask);
   }
   int inliers = 0;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "common/config/options.h"
 #include "services/perception/geometry/rigid3.h"
@@ -57,18 +58,29 @@ struct PoseEstimate {
   bool used_ransac = false;
 };
 
+// A soft prior on the rotation of cam_from_world (an object's SLAM: the rotation the
+// object's frame would give if it did not turn since its last keyframe), residual
+// LogSO3(R * target^T) / sigma_rad, weighted against reprojection errors of sigma_px.
+struct PoseRotationPrior {
+  Eigen::Quaterniond cam_from_world = Eigen::Quaterniond::Identity();
+  double sigma_rad = 1.0;
+};
+
 // `prior` (e.g. constant-velocity prediction) is refined directly when it already
 // explains most correspondences; otherwise EPnP RANSAC runs first.
 PoseEstimate EstimatePose(const std::vector<Eigen::Vector3d>& points_in_world,
                           const std::vector<Eigen::Vector2d>& xy, double focal_px,
-                          const std::optional<Rigid3d>& prior, const PoseEstimatorOptions& options);
+                          const std::optional<Rigid3d>& prior, const PoseEstimatorOptions& options,
+                          const std::optional<PoseRotationPrior>& rotation_prior = std::nullopt);
 
 // Motion-only refinement (Huber-weighted Gauss-Newton on a left perturbation).
 // Returns the refined pose and sets the information matrix J^T W J (in 1/px^2 units
-// scaled by focal^2) when `information` is given.
+// scaled by focal^2) when `information` is given. A rotation prior enters with weight
+// (sigma_px / focal_px)^2 / sigma_rad^2, so that `information` keeps its units.
 Rigid3d RefinePose(const Rigid3d& initial, const std::vector<Eigen::Vector3d>& points_in_world,
                    const std::vector<Eigen::Vector2d>& xy, const std::vector<uint8_t>& use,
-                   double focal_px, double huber_px, int iterations, Matrix6d* information);
+                   double focal_px, double huber_px, int iterations, Matrix6d* information,
+                   const PoseRotationPrior* rotation_prior = nullptr, double sigma_px = 1.0);
 
 }  // namespace mbslam
 

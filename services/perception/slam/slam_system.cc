@@ -59,6 +59,7 @@ void SlamSystem::Flush() { MergeBundleAdjustment(/*wait=*/true); }
 
 void SlamSystem::Reset() {
   Flush();
+  ++map_generation_;
   bridge_.reset();
   map_.Clear();
   state_ = SlamState::kNotInitialized;
@@ -66,6 +67,8 @@ void SlamSystem::Reset() {
   init_pending_frame_ = -1;
   init_ref_xy_.clear();
   init_ref_odom_.reset();
+  init_ref_rotation_prior_.reset();
+  rotation_prior_active_ = false;
   recent_poses_.clear();
   lost_frames_ = 0;
   metric_ = false;
@@ -224,7 +227,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   }
   out.num_correspondences = static_cast<int>(X.size());
   PoseEstimate est;
-  if (X.size() >= 6) est = EstimatePose(X, xy, frame.focal_px, prior, options_.pose);
+  if (X.size() >= 6) est = EstimatePose(X, xy, frame.focal_px, prior, options_.pose, TrackingRotationPrior(frame));
   const bool good = est.ok && est.num_inliers >= options_.min_tracking_inliers;
   MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": correspondences " << X.size() << " (re-found "
                     << refound_ids.size() << "), inliers " << est.num_inliers << ", rms " << est.rms_px
@@ -373,6 +376,8 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
     init_pending_frame_ = -1;
     init_ref_xy_ = current;
     init_ref_odom_ = frame.odom_from_cam;
+    init_ref_rotation_prior_ = frame.rotation_prior;
+    init_ref_utime_ = frame.utime;
     state_ = SlamState::kInitializing;
   };
   if (init_ref_frame_ < 0 || frame.frame_index - init_ref_frame_ > options_.init_max_frames) {
@@ -467,42 +472,68 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
     pr[i] = cv::Point2d(xr[i].x(), xr[i].y());
     pn[i] = cv::Point2d(xn[i].x(), xn[i].y());
   }
-  cv::Mat e_mask, h_mask;
-  cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, e_mask);
-  cv::Mat H = cv::findHomography(pr, pn, cv::RANSAC, 1.5 * thresh, h_mask, 2000, 0.999);
-  if (E.empty() || E.rows != 3) return;
-  const int e_inl = cv::countNonZero(e_mask);
-  const int h_inl = H.empty() ? 0 : cv::countNonZero(h_mask);
-
   // Candidate motions: from E (recoverPose), or from the homography decomposition
-  // when the homography explains the views (planar scene or too little parallax).
+  // when the homography explains the views (planar scene or too little parallax), or,
+  // when both views carry a rotation prior of one reference, the known rotation with
+  // the translation fitted to it (a small object spans a few degrees, where E confuses
+  // a sideways translation with a turn).
   struct Candidate {
     Rigid3d cam1_from_cam0;
     cv::Mat mask;
   };
   std::vector<Candidate> candidates;
-  const bool planar = h_inl >= options_.init_homography_ratio * e_inl;
-  if (!planar) {
-    cv::Mat R, t, mask = e_mask.clone();
-    if (cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask) <
-        options_.init_min_points) {
-      return;
+  int e_inl = 0, h_inl = 0;
+  bool planar = false;
+  cv::Mat e_mask, h_mask;
+  cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, e_mask);
+  if (E.empty() || E.rows != 3) return;
+  e_inl = cv::countNonZero(e_mask);
+  // The body kept its rotation in the prior's frame when the known rotation explains
+  // (nearly) as many correspondences as a free essential matrix; a turning body does not,
+  // and its map then runs without the prior.
+  rotation_prior_active_ = false;
+  std::optional<KnownRotationTranslation> kt;
+  if (UsesRotationPrior() && frame.rotation_prior && init_ref_rotation_prior_ &&
+      frame.rotation_prior->ref_id == init_ref_rotation_prior_->ref_id) {
+    const Eigen::Matrix3d R =
+        (frame.rotation_prior->cam_from_ref * init_ref_rotation_prior_->cam_from_ref.conjugate()).toRotationMatrix();
+    kt = TranslationGivenRotation(xr, xn, R, thresh, 200);
+    if (kt && kt->count >= options_.init_min_points && kt->count >= options_.rotation_prior_min_inlier_ratio * e_inl) {
+      rotation_prior_active_ = true;
+      cv::Mat mask(static_cast<int>(n), 1, CV_8U);
+      for (size_t i = 0; i < n; ++i) mask.at<uint8_t>(static_cast<int>(i)) = kt->inliers[i];
+      for (double sign : {1.0, -1.0}) candidates.push_back(Candidate{Rigid3d(R, sign * kt->t_unit), mask});
     }
-    Eigen::Matrix3d Re;
-    Eigen::Vector3d te;
-    cv::cv2eigen(R, Re);
-    cv::cv2eigen(t, te);
-    candidates.push_back(Candidate{Rigid3d(Re, te.normalized()), mask});
-  } else {
-    std::vector<cv::Mat> Rs, ts, normals;
-    cv::decomposeHomographyMat(H, cv::Mat::eye(3, 3, CV_64F), Rs, ts, normals);
-    for (size_t i = 0; i < Rs.size(); ++i) {
+    MBSLAM_LOG(DEBUG) << "SLAM init frame " << frame.frame_index << ": known rotation explains "
+                      << (kt ? kt->count : 0) << " of the essential matrix's " << e_inl << " inliers"
+                      << (rotation_prior_active_ ? "" : ": the body turns, no rotation prior");
+  }
+  if (!rotation_prior_active_) {
+    cv::Mat H = cv::findHomography(pr, pn, cv::RANSAC, 1.5 * thresh, h_mask, 2000, 0.999);
+    h_inl = H.empty() ? 0 : cv::countNonZero(h_mask);
+    planar = h_inl >= options_.init_homography_ratio * e_inl;
+    if (!planar) {
+      cv::Mat R, t, mask = e_mask.clone();
+      if (cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask) <
+          options_.init_min_points) {
+        return;
+      }
       Eigen::Matrix3d Re;
       Eigen::Vector3d te;
-      cv::cv2eigen(Rs[i], Re);
-      cv::cv2eigen(ts[i], te);
-      if (te.norm() < 1e-9) continue;
-      candidates.push_back(Candidate{Rigid3d(Re, te.normalized()), h_mask});
+      cv::cv2eigen(R, Re);
+      cv::cv2eigen(t, te);
+      candidates.push_back(Candidate{Rigid3d(Re, te.normalized()), mask});
+    } else {
+      std::vector<cv::Mat> Rs, ts, normals;
+      cv::decomposeHomographyMat(H, cv::Mat::eye(3, 3, CV_64F), Rs, ts, normals);
+      for (size_t i = 0; i < Rs.size(); ++i) {
+        Eigen::Matrix3d Re;
+        Eigen::Vector3d te;
+        cv::cv2eigen(Rs[i], Re);
+        cv::cv2eigen(ts[i], te);
+        if (te.norm() < 1e-9) continue;
+        candidates.push_back(Candidate{Rigid3d(Re, te.normalized()), h_mask});
+      }
     }
   }
   // Triangulate each candidate; keep the one with most good points.
@@ -598,7 +629,9 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   }
   Keyframe k0;
   k0.frame_index = init_ref_frame_;
+  k0.utime = init_ref_utime_;
   k0.cam_from_world = Rigid3d();
+  k0.rotation_prior = init_ref_rotation_prior_;
   k0.fixed = true;
   k0.track_xy = init_ref_xy_;
   for (int64_t id : other_motion) {
@@ -621,6 +654,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
     k1.has_odometry = true;
     k1.odom_from_cam = *frame.odom_from_cam;
   }
+  k1.rotation_prior = frame.rotation_prior;
   const int64_t id0 = map_.AddKeyframe(std::move(k0));
   const int64_t id1 = map_.AddKeyframe(std::move(k1));
   for (const auto& [i, X] : best->points) {
@@ -635,7 +669,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
     map_.AddObservation(pid, id1, xn[i]);
   }
   // Global BA of the two views, inline.
-  BaProblem problem = ExtractBaProblem(map_, 2, true, frame.focal_px, metric_);
+  BaProblem problem = ExtractBa(2, true, frame.focal_px, metric_);
   const BaSummary s = SolveBa(&problem, options_.ba);
   if (s.usable) ApplyBaResult(problem, options_.ba, &map_);
   ++ba_runs_;
@@ -732,6 +766,7 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
     kf.has_odometry = true;
     kf.odom_from_cam = *frame.odom_from_cam;
   }
+  kf.rotation_prior = frame.rotation_prior;
   auto is_static = [&labels](int64_t track) {
     auto it = labels.find(track);
     return it != labels.end() && it->second == 0;
@@ -899,10 +934,40 @@ SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered
   return update;
 }
 
+BaProblem SlamSystem::ExtractBa(int window, bool global, double focal_px, bool use_odometry) const {
+  BaProblem p = ExtractBaProblem(map_, window, global, focal_px, use_odometry);
+  if (rotation_prior_active_) {
+    p.rotation_prior_floor_rad = options_.rotation_prior_floor_rad;
+    p.rotation_prior_rad_per_s = options_.rotation_prior_rad_per_s;
+  }
+  return p;
+}
+
+bool SlamSystem::UsesRotationPrior() const {
+  return options_.rotation_prior_floor_rad > 0.0 || options_.rotation_prior_rad_per_s > 0.0;
+}
+
+std::optional<PoseRotationPrior> SlamSystem::TrackingRotationPrior(const SlamFrame& frame) const {
+  if (!frame.rotation_prior || !UsesRotationPrior() || !rotation_prior_active_) return std::nullopt;
+  for (auto it = map_.keyframes().rbegin(); it != map_.keyframes().rend(); ++it) {
+    const Keyframe& k = it->second;
+    if (!k.rotation_prior || k.rotation_prior->ref_id != frame.rotation_prior->ref_id) continue;
+    // If the body did not turn: cam_from_body = (cam_from_ref * ref_from_cam_k) * cam_k_from_body.
+    PoseRotationPrior prior;
+    prior.cam_from_world =
+        (frame.rotation_prior->cam_from_ref * k.rotation_prior->cam_from_ref.conjugate() * k.cam_from_world.rotation)
+            .normalized();
+    const double dt_s = 1e-6 * static_cast<double>(std::abs(frame.utime - k.utime));
+    prior.sigma_rad = options_.rotation_prior_floor_rad + options_.rotation_prior_rad_per_s * dt_s;
+    if (prior.sigma_rad <= 0.0) return std::nullopt;
+    return prior;
+  }
+  return std::nullopt;
+}
+
 void SlamSystem::StartBundleAdjustment(bool global) {
   if (!options_.background_ba) {
-    BaProblem problem = ExtractBaProblem(map_, options_.ba.window_keyframes, global, focal_px_,
-                                         metric_ && options_.use_odometry);
+    BaProblem problem = ExtractBa(options_.ba.window_keyframes, global, focal_px_, metric_ && options_.use_odometry);
     const BaSummary s = SolveBa(&problem, options_.ba);
     ++ba_runs_;
     last_ba_seconds_ = s.seconds;
@@ -911,8 +976,8 @@ void SlamSystem::StartBundleAdjustment(bool global) {
   }
   if (ba_running_) return;  // the next keyframe triggers another run
   MergeBundleAdjustment(true);
-  ba_problem_ = std::make_unique<BaProblem>(ExtractBaProblem(
-      map_, options_.ba.window_keyframes, global, focal_px_, metric_ && options_.use_odometry));
+  ba_problem_ = std::make_unique<BaProblem>(
+      ExtractBa(options_.ba.window_keyframes, global, focal_px_, metric_ && options_.use_odometry));
   ba_running_ = true;
   ba_thread_ = std::thread([this] {
     // Lower priority than the per-image loop: on a 2-core robot computer the BA must not

@@ -94,6 +94,16 @@ struct SlamOptions {
   int guided_max_points = 400;           // at most this many searches per image (count)
   std::string map_load_path;             // map loaded at start ("" = none)
   std::string map_save_path;             // map saved at exit ("" = none)
+  // Images that carry a rotation prior (SlamFrame::rotation_prior) constrain the rotation
+  // between keyframes (bundle adjustment) and from the last keyframe (tracking) within
+  // sigma = floor + rate * elapsed time: the body's angular speed in the reference frame.
+  // Set for the moving objects' SLAMs from their options (ObjectReconstruction); the
+  // static world's images carry no prior, so these are not its options. Both 0 = unused.
+  double rotation_prior_floor_rad = 0.0;
+  double rotation_prior_rad_per_s = 0.0;
+  // A map uses the prior only if, at its initialisation, the known rotation explains at
+  // least this share of a free essential matrix's inliers (else the body turns).
+  double rotation_prior_min_inlier_ratio = 1.0;
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(pose);
@@ -126,6 +136,9 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION(depth_bound_margin > 0.0 && depth_bound_margin < 1.0);
     MBSLAM_CHECK_OPTION_GT(frustum_bound_factor, 1.0);
     MBSLAM_CHECK_OPTION_GT(metric_min_baseline_m, 0.0);
+    MBSLAM_CHECK_OPTION_GE(rotation_prior_floor_rad, 0.0);
+    MBSLAM_CHECK_OPTION_GE(rotation_prior_rad_per_s, 0.0);
+    MBSLAM_CHECK_OPTION(rotation_prior_min_inlier_ratio >= 0.0 && rotation_prior_min_inlier_ratio <= 1.0);
     return true;
   }
   template <typename V>
@@ -196,6 +209,7 @@ struct SlamFrame {
   double focal_px = 1.0;
   std::vector<SlamObservation> observations;          // active tracks
   std::optional<Rigid3d> odom_from_cam;                // interpolated odometry (metric), if any
+  std::optional<CameraRotationPrior> rotation_prior;   // the camera's rotation in a frame the body barely turns in, if any
   std::vector<std::vector<Eigen::Vector2f>> moving_hulls_xy;  // moving objects' hulls (normalised coordinates)
   uint8_t mean_gray = 128;
   cv::Mat image;                                       // gray image (level 0), for guided matching
@@ -268,6 +282,9 @@ class SlamSystem {
   bool initialized() const { return state_ == SlamState::kTracking || state_ == SlamState::kConfirming; }
   bool HasPoint(int64_t track_id) const { return map_.PointOfTrack(track_id) >= 0; }
   bool metric() const { return metric_; }
+  // Counts the maps dropped (Reset, re-initialisation after a loss): the frame of the
+  // poses changes with it.
+  int64_t map_generation() const { return map_generation_; }
   int64_t ba_runs() const { return ba_runs_; }
   double last_ba_seconds() const { return last_ba_seconds_; }
 
@@ -280,6 +297,12 @@ class SlamSystem {
                    SlamMapUpdate* update);
   bool NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const;
   void StartBundleAdjustment(bool global);
+  // ExtractBaProblem with this SLAM's rotation prior settings.
+  BaProblem ExtractBa(int window, bool global, double focal_px, bool use_odometry) const;
+  // The rotation prior of `frame` against the last keyframe with one of the same
+  // reference, for the resection; nullopt without one.
+  std::optional<PoseRotationPrior> TrackingRotationPrior(const SlamFrame& frame) const;
+  bool UsesRotationPrior() const;
   void MergeBundleAdjustment(bool wait);
   // Oldest keyframes beyond max_keyframes, with the points they leave unobserved; returns
   // the number of points removed.
@@ -304,6 +327,8 @@ class SlamSystem {
   int init_pending_tracks_ = 0;      // tracks it shared with the reference
   std::unordered_map<int64_t, Eigen::Vector2d> init_ref_xy_;
   std::optional<Rigid3d> init_ref_odom_;
+  std::optional<CameraRotationPrior> init_ref_rotation_prior_;
+  int64_t init_ref_utime_ = 0;
   int confirm_count_ = 0;
 
   // Recent camera poses (frame index -> pose, covariance) for segmentation.
@@ -334,6 +359,8 @@ class SlamSystem {
   int last_inliers_ = 0;
   bool metric_ = false;
   bool just_initialized_ = false;
+  int64_t map_generation_ = 0;
+  bool rotation_prior_active_ = false;  // this map was initialised with the rotation prior
 
   // After a loss the next map continues the previous world frame: the pose is carried
   // over the gap with the last velocity, and (without metric scale) the units follow

@@ -55,7 +55,34 @@ struct OdometryTranslationPriorFunctor {
   const double sigma_;
 };
 
+struct RelativeRotationPriorFunctor {
+  RelativeRotationPriorFunctor(const Eigen::Quaterniond& b_from_a, double sigma)
+      : inv_wxyz_{b_from_a.w(), -b_from_a.x(), -b_from_a.y(), -b_from_a.z()}, sigma_(sigma) {}
+
+  template <typename T>
+  bool operator()(const T* qa, const T* qb, T* residual) const {
+    const T qa_inv[4] = {qa[3], -qa[0], -qa[1], -qa[2]};
+    const T qb_wxyz[4] = {qb[3], qb[0], qb[1], qb[2]};
+    const T expected_inv[4] = {T(inv_wxyz_[0]), T(inv_wxyz_[1]), T(inv_wxyz_[2]), T(inv_wxyz_[3])};
+    T ba[4], e[4];
+    ceres::QuaternionProduct(qb_wxyz, qa_inv, ba);
+    ceres::QuaternionProduct(ba, expected_inv, e);
+    // The error rotation and its negative are the same rotation: take the short way.
+    const T sign = e[0] < T(0) ? T(-1) : T(1);
+    for (int i = 0; i < 3; ++i) residual[i] = T(2) * sign * e[i + 1] / T(sigma_);
+    return true;
+  }
+
+  const double inv_wxyz_[4];
+  const double sigma_;
+};
+
 }  // namespace
+
+ceres::CostFunction* CreateRelativeRotationPrior(const Eigen::Quaterniond& b_from_a, double sigma_rad) {
+  return new ceres::AutoDiffCostFunction<RelativeRotationPriorFunctor, 3, 4, 4>(
+      new RelativeRotationPriorFunctor(b_from_a.normalized(), sigma_rad));
+}
 
 ceres::CostFunction* CreateReprojectionError(const Eigen::Vector2d& xy, double focal_px) {
   return new ceres::AutoDiffCostFunction<ReprojectionErrorFunctor, 2, 4, 3, 3>(

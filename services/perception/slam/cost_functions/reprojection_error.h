@@ -6,6 +6,7 @@
 // that including this header is cheap.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace ceres {
 class CostFunction;
@@ -26,6 +27,12 @@ ceres::CostFunction* CreateReprojectionError(const Eigen::Vector2d& xy, double f
 //   r = (R_a (c_b - c_a) - d_ab_in_a) / sigma,
 // Parameter blocks: q_a [4], t_a [3], q_b [4], t_b [3]; residuals: 3.
 ceres::CostFunction* CreateOdometryTranslationPrior(const Eigen::Vector3d& d_ab_in_a, double sigma_m);
+
+// Relative-rotation prior between two keyframes a and b: the rotation from a's camera to
+// b's must match `b_from_a` (e.g. the camera's own rotation when the mapped body does not
+// turn): r = 2 vec(q_b q_a^-1 b_from_a^-1) / sigma (the rotation angle error for small
+// errors, rad / rad). Parameter blocks: q_a [4], q_b [4]; residuals: 3.
+ceres::CostFunction* CreateRelativeRotationPrior(const Eigen::Quaterniond& b_from_a, double sigma_rad);
 
 }  // namespace mbslam
 
