@@ -50,6 +50,7 @@ struct Scene {
 TEST(SlamBackfill, EarlierImagesGetTheirPosesWhenTheMapIsConfirmed) {
   const Scene scene(3);
   SlamOptions options;
+  options.ba.time_limited = false;  // a loaded machine must not cut the BA short
   options.background_ba = false;
   SlamSystem slam(options);
   std::map<int64_t, Rigid3d> live, backfilled;
@@ -109,6 +110,7 @@ int InitImage(const Scene& scene, const SlamOptions& options, int drop_after = 1
 TEST(SlamBackfill, ShortBaselineInitialisationWaitsForParallax) {
   const Scene scene(5);
   SlamOptions options;
+  options.ba.time_limited = false;  // a loaded machine must not cut the BA short
   options.background_ba = false;
   options.init_good_parallax_deg = 0.0;
   const int at_once = InitImage(scene, options);
@@ -130,6 +132,7 @@ TEST(SlamBackfill, ShortBaselineInitialisationWaitsForParallax) {
 TEST(SlamBackfill, OffKeepsOnlyLivePoses) {
   const Scene scene(4);
   SlamOptions options;
+  options.ba.time_limited = false;  // a loaded machine must not cut the BA short
   options.background_ba = false;
   options.backfill_max_frames = 0;
   SlamSystem slam(options);

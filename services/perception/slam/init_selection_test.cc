@@ -150,6 +150,7 @@ std::set<int64_t> MapTracksAfterInit(const SlamOptions& options, const TwoMotion
 TEST(InitSelection, SlamInitialisesOnTheBackground) {
   const TwoMotionScene s = MakeScene(150, 260, 5);
   SlamOptions options;
+  options.ba.time_limited = false;  // a loaded machine must not cut the BA short
   options.background_ba = false;
   options.init_good_parallax_deg = 0.0;  // two images: no waiting for more parallax
   const std::set<int64_t> tracks = MapTracksAfterInit(options, s);
@@ -164,6 +165,7 @@ TEST(InitSelection, SlamInitialisesOnTheBackground) {
 TEST(InitSelection, ParallaxOnlyOnAFollowedObjectIsRefused) {
   const TwoMotionScene s = MakeScene(150, 260, 6, /*followed=*/true);
   SlamOptions options;
+  options.ba.time_limited = false;  // a loaded machine must not cut the BA short
   options.background_ba = false;
   options.init_good_parallax_deg = 0.0;  // two images: no waiting for more parallax
   EXPECT_TRUE(MapTracksAfterInit(options, s).empty());
