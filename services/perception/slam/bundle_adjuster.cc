@@ -11,6 +11,10 @@
 
 namespace mbslam {
 
+double RotationPriorSigma(double floor_rad, double rad_per_s, int64_t dt_us) {
+  return floor_rad + rad_per_s * 1e-6 * static_cast<double>(std::abs(dt_us));
+}
+
 BaProblem ExtractBaProblem(const Map& map, int window, bool global, double focal_px, bool use_odometry) {
   BaProblem p;
   p.focal_px = focal_px;
@@ -132,8 +136,8 @@ BaSummary SolveBa(BaProblem* p, const BundleAdjustmentOptions& o) {
           !(prev->fixed && pose.fixed)) {
         const Eigen::Quaterniond b_from_a =
             pose.rotation_prior->cam_from_ref * prev->rotation_prior->cam_from_ref.conjugate();
-        const double dt_s = 1e-6 * static_cast<double>(std::abs(pose.utime - prev->utime));
-        const double sigma = p->rotation_prior_floor_rad + p->rotation_prior_rad_per_s * dt_s;
+        const double sigma =
+            RotationPriorSigma(p->rotation_prior_floor_rad, p->rotation_prior_rad_per_s, pose.utime - prev->utime);
         problem.AddResidualBlock(CreateRelativeRotationPrior(b_from_a, sigma), nullptr, q_ptr(prev_id),
                                  q_ptr(id));
       }

@@ -96,6 +96,9 @@ struct BaSummary {
   double seconds = 0.0;
 };
 
+// The rotation prior's sigma between two images `dt_us` apart: floor + rate * |dt| (rad).
+double RotationPriorSigma(double floor_rad, double rad_per_s, int64_t dt_us);
+
 // Copies the local window (the last `window` keyframes, the points they observe, and
 // the other keyframes observing those points, held fixed). `global` takes all.
 BaProblem ExtractBaProblem(const Map& map, int window, bool global, double focal_px, bool use_odometry);

@@ -482,22 +482,21 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
     cv::Mat mask;
   };
   std::vector<Candidate> candidates;
-  int e_inl = 0, h_inl = 0;
-  bool planar = false;
   cv::Mat e_mask, h_mask;
   cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, e_mask);
   if (E.empty() || E.rows != 3) return;
-  e_inl = cv::countNonZero(e_mask);
+  const int e_inl = cv::countNonZero(e_mask);
+  int h_inl = 0;
+  bool planar = false;
   // The body kept its rotation in the prior's frame when the known rotation explains
   // (nearly) as many correspondences as a free essential matrix; a turning body does not,
   // and its map then runs without the prior.
   rotation_prior_active_ = false;
-  std::optional<KnownRotationTranslation> kt;
   if (UsesRotationPrior() && frame.rotation_prior && init_ref_rotation_prior_ &&
       frame.rotation_prior->ref_id == init_ref_rotation_prior_->ref_id) {
     const Eigen::Matrix3d R =
         (frame.rotation_prior->cam_from_ref * init_ref_rotation_prior_->cam_from_ref.conjugate()).toRotationMatrix();
-    kt = TranslationGivenRotation(xr, xn, R, thresh, 200);
+    const std::optional<KnownRotationTranslation> kt = TranslationGivenRotation(xr, xn, R, thresh, 200);
     if (kt && kt->count >= options_.init_min_points && kt->count >= options_.rotation_prior_min_inlier_ratio * e_inl) {
       rotation_prior_active_ = true;
       cv::Mat mask(static_cast<int>(n), 1, CV_8U);
@@ -957,8 +956,8 @@ std::optional<PoseRotationPrior> SlamSystem::TrackingRotationPrior(const SlamFra
     prior.cam_from_world =
         (frame.rotation_prior->cam_from_ref * k.rotation_prior->cam_from_ref.conjugate() * k.cam_from_world.rotation)
             .normalized();
-    const double dt_s = 1e-6 * static_cast<double>(std::abs(frame.utime - k.utime));
-    prior.sigma_rad = options_.rotation_prior_floor_rad + options_.rotation_prior_rad_per_s * dt_s;
+    prior.sigma_rad =
+        RotationPriorSigma(options_.rotation_prior_floor_rad, options_.rotation_prior_rad_per_s, frame.utime - k.utime);
     if (prior.sigma_rad <= 0.0) return std::nullopt;
     return prior;
   }
