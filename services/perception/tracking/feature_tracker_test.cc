@@ -209,6 +209,41 @@ TEST(ConvexHull, HullAndInside) {
   EXPECT_FALSE(InsideConvexHull(hull, {5, 1}));
 }
 
+// ExtractPatch gives cv::getRectSubPix's bytes: random sub-pixel centres, integer and
+// half-pixel ones, and centres against every image edge (the last column / row read
+// at zero weight goes through OpenCV's own border).
+TEST(PatchMatcher, ExtractPatchIsGetRectSubPixBitForBit) {
+  cv::RNG rng(3);
+  cv::Mat image(120, 160, CV_8UC1);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+  image(cv::Rect(20, 20, 30, 30)).setTo(255);  // saturated weights' sum
+  for (int size : {5, 11, 15}) {
+    const float half = 0.5f * static_cast<float>(size - 1);
+    std::vector<Eigen::Vector2f> centres = {{half, half},
+                                            {159.0f - half, 119.0f - half},
+                                            {159.0f - half - 0.25f, 60.0f},
+                                            {80.0f, 119.0f - half - 0.5f},
+                                            {35.0f, 35.0f},
+                                            {35.5f, 35.25f}};
+    for (int k = 0; k < 3000; ++k) {
+      Eigen::Vector2f c(rng.uniform(half, 159.0f - half), rng.uniform(half, 119.0f - half));
+      if (k % 5 == 0) c.x() = std::floor(c.x()) + 0.5f;
+      if (k % 7 == 0) c.y() = std::floor(c.y());
+      centres.push_back(c);
+    }
+    for (const Eigen::Vector2f& c : centres) {
+      cv::Mat got, want;
+      ASSERT_TRUE(ExtractPatch(image, c, size, &got)) << c.transpose();
+      cv::getRectSubPix(image, cv::Size(size, size), cv::Point2f(c.x(), c.y()), want, CV_8U);
+      ASSERT_EQ(got.type(), CV_8UC1);
+      ASSERT_EQ(cv::countNonZero(got != want), 0) << "size " << size << " at " << c.transpose();
+    }
+    cv::Mat none;
+    EXPECT_FALSE(ExtractPatch(image, {half - 0.01f, 50.0f}, size, &none));
+    EXPECT_FALSE(ExtractPatch(image, {50.0f, 119.0f - half + 0.01f}, size, &none));
+  }
+}
+
 TEST(PatchMatcher, FindsShiftedPatch) {
   const cv::Mat base = Texture(200, 200, 6);
   cv::Mat patch;

@@ -3,22 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-// x86-64 with GCC or Clang: an AVX2 clone next to the baseline one (glibc picks at load
-// time). Elsewhere (ARM: NEON is the baseline there), and under the sanitizers (whose
-// runtime is not up when the loader picks), one build.
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer) || __has_feature(thread_sanitizer)
-#define MBSLAM_KLT_NO_CLONES
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define MBSLAM_KLT_NO_CLONES
-#endif
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(MBSLAM_KLT_NO_CLONES)
-#define MBSLAM_KLT_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MBSLAM_KLT_CLONES
-#endif
+#include "common/util/simd_clones.h"
 
 namespace mbslam {
 namespace {
@@ -83,7 +68,7 @@ inline bool Readable(const Level& l, int x, int y, int cols, int rows) {
 // AVX2 and for the baseline, the better one picked at load time: the loops are
 // element-wise (their sums are per column), so both give the same bits.
 template <int WP>
-MBSLAM_KLT_CLONES void TrackRange(const std::vector<Level>& lf, const std::vector<Level>& lt, int top, int w,
+MBSLAM_SIMD_CLONES void TrackRange(const std::vector<Level>& lf, const std::vector<Level>& lt, int top, int w,
                 const std::vector<cv::Point2f>& pts, std::vector<cv::Point2f>* next,
                 std::vector<uint8_t>* status, const KltParams& params) {
   constexpr int TW = WP + 4;  // template width: the window, a one-pixel ring, rounded up to 4

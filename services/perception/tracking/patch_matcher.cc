@@ -10,7 +10,35 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "common/util/simd_clones.h"
+
 namespace mbslam {
+
+namespace {
+
+// ExtractPatch's fixed-width rows (16 columns read, `size` kept), in float, which
+// vectorises (32-bit integer products do not, on baseline x86-64): every product and
+// partial sum is an integer below 255 * 65538 < 2^24, exact in float, and scaling by
+// 2^-16 is exact, so this is the integer arithmetic's result.
+MBSLAM_SIMD_CLONES void SampleRows16(const cv::Mat& image, int ix, int iy, int size, int32_t w00, int32_t w01,
+                                     int32_t w10, int32_t w11, cv::Mat* patch) {
+  constexpr int kLanes = 16;  // reads columns ix .. ix + 16
+  const float f00 = static_cast<float>(w00), f01 = static_cast<float>(w01);
+  const float f10 = static_cast<float>(w10), f11 = static_cast<float>(w11);
+  for (int r = 0; r < size; ++r) {
+    const uint8_t* __restrict s0 = image.ptr<uint8_t>(iy + r) + ix;
+    const uint8_t* __restrict s1 = image.ptr<uint8_t>(iy + r + 1) + ix;
+    uint8_t row[kLanes];
+    for (int c = 0; c < kLanes; ++c) {
+      const float v = static_cast<float>(s0[c]) * f00 + static_cast<float>(s0[c + 1]) * f01 +
+                      static_cast<float>(s1[c]) * f10 + static_cast<float>(s1[c + 1]) * f11;
+      row[c] = static_cast<uint8_t>(static_cast<int32_t>((v + 32768.0f) * (1.0f / 65536.0f)));
+    }
+    std::copy(row, row + size, patch->ptr<uint8_t>(r));
+  }
+}
+
+}  // namespace
 
 bool ExtractPatch(const cv::Mat& image, const Eigen::Vector2f& uv, int size, cv::Mat* patch) {
   const float half = 0.5f * static_cast<float>(size - 1);
@@ -18,7 +46,34 @@ bool ExtractPatch(const cv::Mat& image, const Eigen::Vector2f& uv, int size, cv:
       uv.y() + half > image.rows - 1.0f) {
     return false;
   }
-  cv::getRectSubPix(image, cv::Size(size, size), cv::Point2f(uv.x(), uv.y()), *patch, CV_8U);
+  // The corner sample and its bilinear weights, as cv::getRectSubPix takes them for
+  // 8-bit images: float weights rounded to 16-bit fixed point, the sum rounded back.
+  const float sx = uv.x() - half, sy = uv.y() - half;
+  const int ix = static_cast<int>(std::floor(sx)), iy = static_cast<int>(std::floor(sy));
+  if (image.type() != CV_8UC1 || ix + size >= image.cols || iy + size >= image.rows) {
+    // The last column or row would read one past the image (at zero weight): OpenCV's
+    // replicated border handles it.
+    cv::getRectSubPix(image, cv::Size(size, size), cv::Point2f(uv.x(), uv.y()), *patch, CV_8U);
+    return true;
+  }
+  const float a = sx - static_cast<float>(ix), b = sy - static_cast<float>(iy);
+  const int32_t w00 = cvRound((1.0f - a) * (1.0f - b) * 65536.0f), w01 = cvRound(a * (1.0f - b) * 65536.0f);
+  const int32_t w10 = cvRound((1.0f - a) * b * 65536.0f), w11 = cvRound(a * b * 65536.0f);
+  // The rounded weights sum to at most 65536 + 2, so the result stays <= 255.
+  patch->create(size, size, CV_8UC1);
+  if (size <= 16 && ix + 17 <= image.cols) {
+    SampleRows16(image, ix, iy, size, w00, w01, w10, w11, patch);
+    return true;
+  }
+  for (int r = 0; r < size; ++r) {
+    const uint8_t* __restrict s0 = image.ptr<uint8_t>(iy + r) + ix;
+    const uint8_t* __restrict s1 = image.ptr<uint8_t>(iy + r + 1) + ix;
+    uint8_t* __restrict out = patch->ptr<uint8_t>(r);
+    for (int c = 0; c < size; ++c) {
+      const int32_t v = s0[c] * w00 + s0[c + 1] * w01 + s1[c] * w10 + s1[c + 1] * w11;
+      out[c] = static_cast<uint8_t>((v + (1 << 15)) >> 16);
+    }
+  }
   return true;
 }
 

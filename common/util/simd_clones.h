@@ -1,0 +1,25 @@
+#ifndef MBSLAM_COMMON_UTIL_SIMD_CLONES_H_
+#define MBSLAM_COMMON_UTIL_SIMD_CLONES_H_
+
+// MBSLAM_SIMD_CLONES before a function definition: on x86-64 with GCC or Clang, an AVX2
+// clone next to the baseline one, glibc picking the better at load time. Only for
+// functions whose loops give the same bits either way (element-wise float arithmetic
+// without reordered reductions, or exact integer arithmetic). Elsewhere (ARM: NEON is
+// the baseline there), and under the sanitizers (whose runtime is not up when the
+// loader picks), one build.
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer) || __has_feature(thread_sanitizer)
+#define MBSLAM_SIMD_NO_CLONES
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define MBSLAM_SIMD_NO_CLONES
+#endif
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(MBSLAM_SIMD_NO_CLONES)
+#define MBSLAM_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define MBSLAM_SIMD_CLONES
+#endif
+
+#endif  // MBSLAM_COMMON_UTIL_SIMD_CLONES_H_
