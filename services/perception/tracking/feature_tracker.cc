@@ -13,6 +13,7 @@
 #include "common/util/parallel_for.h"
 #include "services/perception/geometry/patch_warp.h"
 #include "services/perception/geometry/polygon.h"
+#include "services/perception/tracking/disc_stamp.h"
 #include "services/perception/tracking/klt.h"
 #include "services/perception/tracking/patch_matcher.h"
 
@@ -557,8 +558,13 @@ void FeatureTracker::EnforceUnicity() {
     if (tracks_[a].age != tracks_[b].age) return tracks_[a].age > tracks_[b].age;
     return tracks_[a].match_error < tracks_[b].match_error;
   });
-  std::unordered_map<int64_t, std::vector<size_t>> grid;
-  auto key = [cell](int gx, int gy) { return (static_cast<int64_t>(gx) << 32) ^ static_cast<uint32_t>(gy); };
+  // The kept tracks by grid cell: the cell's first track, then a chain through `next`
+  // (no per-cell allocation).
+  std::unordered_map<int64_t, size_t> first_in_cell;
+  first_in_cell.reserve(tracks_.size());
+  constexpr size_t kNone = static_cast<size_t>(-1);
+  std::vector<size_t> next(tracks_.size(), kNone);
+  auto key = [](int gx, int gy) { return (static_cast<int64_t>(gx) << 32) ^ static_cast<uint32_t>(gy); };
   std::vector<bool> keep(tracks_.size(), true);
   const float r2 = static_cast<float>(options_.unicity_px * options_.unicity_px);
   for (size_t i : order) {
@@ -569,9 +575,9 @@ void FeatureTracker::EnforceUnicity() {
     bool clash = false;
     for (int dx = -1; dx <= 1 && !clash; ++dx) {
       for (int dy = -1; dy <= 1 && !clash; ++dy) {
-        auto it = grid.find(key(gx + dx, gy + dy));
-        if (it == grid.end()) continue;
-        for (size_t j : it->second) {
+        auto it = first_in_cell.find(key(gx + dx, gy + dy));
+        if (it == first_in_cell.end()) continue;
+        for (size_t j = it->second; j != kNone; j = next[j]) {
           if ((tracks_[j].uv - t.uv).squaredNorm() < r2) {
             clash = true;
             break;
@@ -583,7 +589,11 @@ void FeatureTracker::EnforceUnicity() {
       keep[i] = false;
       ++stats_.rejected_unicity;
     } else {
-      grid[key(gx, gy)].push_back(i);
+      auto [it, inserted] = first_in_cell.try_emplace(key(gx, gy), i);
+      if (!inserted) {
+        next[i] = it->second;
+        it->second = i;
+      }
     }
   }
   std::vector<Track> out;
@@ -614,10 +624,10 @@ void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
     mask(cv::Rect(b, b, image.cols - 2 * b, image.rows - 2 * b)).setTo(255);
   }
   const int radius = static_cast<int>(std::ceil(options_.min_distance_px));
+  if (disc_.radius() != radius) disc_ = DiscStamp(radius);  // the option is fixed: built once
   std::vector<int> count(static_cast<size_t>(cells), 0);
   for (const Track& t : tracks_) {
-    cv::circle(mask, cv::Point(static_cast<int>(std::lround(t.uv.x())), static_cast<int>(std::lround(t.uv.y()))),
-               radius, cv::Scalar(0), -1);
+    disc_.Stamp(&mask, cv::Point(static_cast<int>(std::lround(t.uv.x())), static_cast<int>(std::lround(t.uv.y()))), 0);
     ++count[static_cast<size_t>(cell_of(t.uv.x(), t.uv.y()))];
   }
 
@@ -703,7 +713,7 @@ void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
         t.is_new = true;
         if (!ExtractPatch(image, t.uv, options_.patch_size, &t.patch)) continue;
         t.anchor = t.patch;
-        cv::circle(mask, cv::Point(x, y), radius, cv::Scalar(0), -1);
+        disc_.Stamp(&mask, cv::Point(x, y), 0);
         ++count[cu];
         ++created;
         progress = true;

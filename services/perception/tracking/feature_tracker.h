@@ -19,6 +19,7 @@
 
 #include "common/config/options.h"
 #include "services/perception/geometry/polygon.h"
+#include "services/perception/tracking/disc_stamp.h"
 #include "services/perception/tracking/klt.h"
 #include "services/perception/tracking/track.h"
 
@@ -273,6 +274,7 @@ class FeatureTracker {
   // Tracks lost in the latest image that guided matching may still recover.
   std::vector<Track> recently_lost_;
   int64_t next_id_ = 1;
+  DiscStamp disc_{0};  // min-distance discs of DetectNew
   int64_t frame_index_ = -1;
   TrackerStats stats_;
   bool last_rejected_ = false;

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "services/perception/tracking/disc_stamp.h"
 #include "services/perception/tracking/patch_matcher.h"
 #include "services/perception/tracking/test_images.h"
 
@@ -212,6 +213,22 @@ TEST(ConvexHull, HullAndInside) {
 // ExtractPatch gives cv::getRectSubPix's bytes: random sub-pixel centres, integer and
 // half-pixel ones, and centres against every image edge (the last column / row read
 // at zero weight goes through OpenCV's own border).
+// DiscStamp sets exactly cv::circle's filled disc: radii 0-20, centres inside, on and
+// beyond every edge of the mask.
+TEST(DiscStamp, SameAsFilledCvCircle) {
+  cv::RNG rng(5);
+  for (int radius = 0; radius <= 20; ++radius) {
+    const DiscStamp disc(radius);
+    for (int k = 0; k < 200; ++k) {
+      const cv::Point c(rng.uniform(-30, 91), rng.uniform(-30, 71));
+      cv::Mat got(40, 60, CV_8UC1, cv::Scalar(255)), want = got.clone();
+      disc.Stamp(&got, c, 0);
+      cv::circle(want, c, radius, cv::Scalar(0), cv::FILLED);
+      ASSERT_EQ(cv::countNonZero(got != want), 0) << "radius " << radius << " centre " << c;
+    }
+  }
+}
+
 TEST(PatchMatcher, ExtractPatchIsGetRectSubPixBitForBit) {
   cv::RNG rng(3);
   cv::Mat image(120, 160, CV_8UC1);
