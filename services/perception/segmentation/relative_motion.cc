@@ -11,16 +11,6 @@
 
 namespace mbslam {
 
-double EpipolarDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& x_r,
-                        const Eigen::Vector2d& x_n) {
-  const Eigen::Vector3d l = E * x_r.homogeneous();
-  // sqrt of the sum, not std::hypot: the components are far from overflow, and hypot's
-  // care about it doubled this function's cost (it runs per track and envelope sample).
-  const double norm = std::sqrt(l.x() * l.x() + l.y() * l.y());
-  if (norm < 1e-15) return 0.0;
-  return x_n.homogeneous().dot(l) / norm;
-}
-
 std::vector<MotionSample> MotionSigmaPoints(const RelativeMotion& motion, double kappa) {
   auto make = [&](const Rigid3d& T, double w) {
     MotionSample s;

@@ -6,11 +6,13 @@
 // evaluated with. It comes from the body's SLAM, from odometry (sec. 3.8), or from a
 // robust two-view estimate on the body's own tracks.
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "common/config/options.h"
 #include "common/util/status.h"
@@ -76,9 +78,17 @@ Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
                               const TwoViewOptions& options, RelativeMotion* motion,
                               std::vector<uint8_t>* inliers);
 
-// Signed distance (normalised units) of x_n to the epipolar line E x_r.
-double EpipolarDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& x_r,
-                        const Eigen::Vector2d& x_n);
+// Signed distance (normalised units) of x_n to the epipolar line E x_r. Inline: it runs
+// per track and envelope sample.
+inline double EpipolarDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& x_r,
+                               const Eigen::Vector2d& x_n) {
+  const Eigen::Vector3d l = E * x_r.homogeneous();
+  // sqrt of the sum, not std::hypot: the components are far from overflow, and hypot's
+  // care about it doubled this function's cost.
+  const double norm = std::sqrt(l.x() * l.x() + l.y() * l.y());
+  if (norm < 1e-15) return 0.0;
+  return x_n.homogeneous().dot(l) / norm;
+}
 
 }  // namespace mbslam
 
