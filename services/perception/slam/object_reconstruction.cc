@@ -9,6 +9,16 @@
 
 namespace mbslam {
 
+std::vector<Eigen::Vector3d> MaturePoints(const Map& map, int min_keyframes) {
+  const size_t need = std::min(static_cast<size_t>(std::max(1, min_keyframes)), map.num_keyframes());
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(map.num_points());
+  for (const auto& [pid, p] : map.points()) {
+    if (p.observations.size() >= need) out.push_back(p.position);
+  }
+  return out;
+}
+
 std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& points, double max_spread) {
   if (max_spread <= 0.0 || points.size() < 8) return points;
   std::vector<double> coords[3];
@@ -157,10 +167,7 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
       if (update.new_keyframe || e.last_points_frame < 0 ||
           frame_index - e.last_points_frame >= options_.points_every_frames) {
         r.points_included = true;
-        std::vector<Eigen::Vector3d> all;
-        all.reserve(e.slam->map().num_points());
-        for (const auto& [pid, p] : e.slam->map().points()) all.push_back(p.position);
-        r.points = CompactPoints(all, options_.max_point_spread);
+        r.points = CompactPoints(MaturePoints(e.slam->map(), options_.min_point_keyframes), options_.max_point_spread);
         e.last_points_frame = frame_index;
       }
     }

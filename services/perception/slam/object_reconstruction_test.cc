@@ -139,3 +139,37 @@ TEST(ObjectReconstructionTest, PublishedPointsLeaveOutPointsFarOutsideTheBody) {
 
 }  // namespace
 }  // namespace mbslam
+
+namespace mbslam {
+namespace {
+
+// Published points: those seen from min_point_keyframes keyframes, or from all of them
+// while the map is younger.
+TEST(ObjectReconstructionTest, MaturePointsNeedThreeKeyframesOnceThereAreThree) {
+  Map map;
+  std::vector<int64_t> kf;
+  for (int k = 0; k < 2; ++k) kf.push_back(map.AddKeyframe(Keyframe()));
+  auto add_point = [&](double x, int views) {
+    MapPoint p;
+    p.position = Eigen::Vector3d(x, 0.0, 0.0);
+    const int64_t id = map.AddPoint(p);
+    for (int v = 0; v < views; ++v) map.AddObservation(id, kf[static_cast<size_t>(v)], Eigen::Vector2d::Zero());
+  };
+  add_point(1.0, 2);
+  add_point(2.0, 1);
+  // Two keyframes: the points both saw.
+  std::vector<Eigen::Vector3d> pts = MaturePoints(map, 3);
+  ASSERT_EQ(pts.size(), 1u);
+  EXPECT_EQ(pts[0].x(), 1.0);
+  kf.push_back(map.AddKeyframe(Keyframe()));
+  add_point(3.0, 3);
+  // Three keyframes: only the point all three saw.
+  pts = MaturePoints(map, 3);
+  ASSERT_EQ(pts.size(), 1u);
+  EXPECT_EQ(pts[0].x(), 3.0);
+  EXPECT_EQ(MaturePoints(map, 1).size(), 3u);
+  EXPECT_EQ(MaturePoints(map, 2).size(), 2u);
+}
+
+}  // namespace
+}  // namespace mbslam
