@@ -210,9 +210,6 @@ TEST(ConvexHull, HullAndInside) {
   EXPECT_FALSE(InsideConvexHull(hull, {5, 1}));
 }
 
-// ExtractPatch gives cv::getRectSubPix's bytes: random sub-pixel centres, integer and
-// half-pixel ones, and centres against every image edge (the last column / row read
-// at zero weight goes through OpenCV's own border).
 // DiscStamp sets exactly cv::circle's filled disc: radii 0-20, centres inside, on and
 // beyond every edge of the mask.
 TEST(DiscStamp, SameAsFilledCvCircle) {
@@ -229,6 +226,9 @@ TEST(DiscStamp, SameAsFilledCvCircle) {
   }
 }
 
+// ExtractPatch gives cv::getRectSubPix's bytes: random sub-pixel centres, integer and
+// half-pixel ones, and centres against every image edge (the last column / row read
+// at zero weight goes through OpenCV's own border).
 TEST(PatchMatcher, ExtractPatchIsGetRectSubPixBitForBit) {
   cv::RNG rng(3);
   cv::Mat image(120, 160, CV_8UC1);

@@ -16,20 +16,22 @@ namespace mbslam {
 
 namespace {
 
-// ExtractPatch's fixed-width rows (16 columns read, `size` kept), in float, which
+// Columns SampleRows16 computes per row; it reads one more.
+constexpr int kSampleLanes = 16;
+
+// ExtractPatch's fixed-width rows (kSampleLanes columns computed, `size` kept), in float, which
 // vectorises (32-bit integer products do not, on baseline x86-64): every product and
 // partial sum is an integer below 255 * 65538 < 2^24, exact in float, and scaling by
 // 2^-16 is exact, so this is the integer arithmetic's result.
 MBSLAM_SIMD_CLONES void SampleRows16(const cv::Mat& image, int ix, int iy, int size, int32_t w00, int32_t w01,
                                      int32_t w10, int32_t w11, cv::Mat* patch) {
-  constexpr int kLanes = 16;  // reads columns ix .. ix + 16
   const float f00 = static_cast<float>(w00), f01 = static_cast<float>(w01);
   const float f10 = static_cast<float>(w10), f11 = static_cast<float>(w11);
   for (int r = 0; r < size; ++r) {
     const uint8_t* __restrict s0 = image.ptr<uint8_t>(iy + r) + ix;
     const uint8_t* __restrict s1 = image.ptr<uint8_t>(iy + r + 1) + ix;
-    uint8_t row[kLanes];
-    for (int c = 0; c < kLanes; ++c) {
+    uint8_t row[kSampleLanes];
+    for (int c = 0; c < kSampleLanes; ++c) {
       const float v = static_cast<float>(s0[c]) * f00 + static_cast<float>(s0[c + 1]) * f01 +
                       static_cast<float>(s1[c]) * f10 + static_cast<float>(s1[c + 1]) * f11;
       row[c] = static_cast<uint8_t>(static_cast<int32_t>((v + 32768.0f) * (1.0f / 65536.0f)));
@@ -61,7 +63,7 @@ bool ExtractPatch(const cv::Mat& image, const Eigen::Vector2f& uv, int size, cv:
   const int32_t w10 = cvRound((1.0f - a) * b * 65536.0f), w11 = cvRound(a * b * 65536.0f);
   // The rounded weights sum to at most 65536 + 2, so the result stays <= 255.
   patch->create(size, size, CV_8UC1);
-  if (size <= 16 && ix + 17 <= image.cols) {
+  if (size <= kSampleLanes && ix + kSampleLanes + 1 <= image.cols) {
     SampleRows16(image, ix, iy, size, w00, w01, w10, w11, patch);
     return true;
   }
