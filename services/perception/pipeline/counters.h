@@ -62,6 +62,7 @@ inline constexpr const char* kCalibrationInvalid = "calibration_invalid";
 inline constexpr const char* kSnapshotDecodeError = "snapshot_request_decode_error";
 inline constexpr const char* kStageOverrun = "stage_overrun";
 inline constexpr const char* kImageRejectedGlitch = "image_rejected_glitch";   // nearly every track lost at once: skipped
+inline constexpr const char* kImageExposureCorrected = "image_exposure_corrected";  // an exposure step undone before tracking
 inline constexpr const char* kImageTimelineReset = "image_timeline_reset";      // time (or size) changed for good: start over
 inline constexpr const char* kImageSeqRestart = "image_seq_restart";            // seq went back (driver restarted)
 inline constexpr const char* kImageSizeChanged = "image_size_changed";          // size differs from the previous images

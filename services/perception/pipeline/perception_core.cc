@@ -493,9 +493,17 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   }
   if (GetLogLevel() <= LogLevel::kDebug) {
     const TrackerStats& ts = tracker_.stats();
-    MBSLAM_LOG(DEBUG) << "image " << frame.seq << ": KLT tracked " << ts.tracked << ", lost " << ts.lost << ", created "
+    MBSLAM_LOG(DEBUG) << "image " << frame.seq << ": KLT tracked " << ts.tracked << ", lost " << ts.lost << " (forward " << ts.lost_forward
+                      << ", backward " << ts.lost_backward << ", forward-backward " << ts.lost_consistency
+                      << ", border " << ts.lost_border << ", appearance " << ts.lost_appearance << "; established "
+                      << ts.established_matched << " of " << ts.established << " kept), created "
                       << ts.created << ", ORB re-found " << ts.descriptor_matched << ", median flow "
                       << ts.median_flow_px << " px" << (ts.fast_motion ? " (fast-motion KLT)" : "");
+  }
+  if (tracker_.stats().exposure_corrected) {
+    MBSLAM_LOG(INFO) << "image " << frame.seq << ": exposure step undone (gain " << tracker_.stats().exposure_gain
+                     << ", offset " << tracker_.stats().exposure_offset << ")";
+    counters_->Increment(counter::kImageExposureCorrected);
   }
   if (tracker_.stats().rejected) {
     // A glitch image (flash, corrupted or foreign frame): no pose and no change to any

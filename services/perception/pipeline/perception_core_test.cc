@@ -83,5 +83,27 @@ TEST(PerceptionCoreTest, GlitchImageIsCountedAndSkipped) {
   core.Finish();
 }
 
+// An exposure step is undone and counted, not rejected as a glitch: the tracks follow it.
+TEST(PerceptionCoreTest, ExposureStepIsCountedAndTracked) {
+  CoreOptions options;
+  options.slam.background_ba = false;
+  Counters counters;
+  StageTimers timers;
+  PerceptionCore core(options, &counters, &timers);
+  const cv::Mat base = Texture(640, 480, 4);
+  const auto K = Intrinsics();
+  for (int k = 0; k < 5; ++k) core.ProcessFrame(Frame(Shifted(base, 2.0 * k), k, K));
+  cv::Mat brighter;
+  Shifted(base, 10.0).convertTo(brighter, CV_8U, 0.5, 110.0);
+  const FrameResult r = core.ProcessFrame(Frame(brighter, 5, K));
+  EXPECT_EQ(counters.Get(counter::kImageRejectedGlitch), 0);
+  EXPECT_EQ(counters.Get(counter::kImageExposureCorrected), 1);
+  EXPECT_GT(r.tracks.size(), 100u);
+  const FrameResult next = core.ProcessFrame(Frame(Shifted(base, 12.0), 6, K));
+  EXPECT_EQ(counters.Get(counter::kImageRejectedGlitch), 0);
+  EXPECT_GT(next.tracks.size(), 100u);
+  core.Finish();
+}
+
 }  // namespace
 }  // namespace mbslam

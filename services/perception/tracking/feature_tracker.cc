@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <unordered_map>
 
 #include <opencv2/features2d.hpp>
@@ -50,6 +51,114 @@ int HammingDistance(const uint8_t* a, const uint8_t* b, int bytes) {
   }
   for (; k < bytes; ++k) d += __builtin_popcount(static_cast<unsigned>(a[k] ^ b[k]));
   return d;
+}
+
+// The brightness change of one image to the next, as the map that undoes it:
+// previous ~ gain * new + offset; mean_change is the new image's mean minus the previous
+// one's (grey levels).
+struct ExposureChange {
+  double gain = 1.0;
+  double offset = 0.0;
+  double mean_change = 0.0;
+};
+
+double MedianOf(std::vector<double>* v) {
+  std::nth_element(v->begin(), v->begin() + static_cast<std::ptrdiff_t>(v->size() / 2), v->end());
+  return (*v)[v->size() / 2];
+}
+
+// From the same scene points seen in both images (a track's template and its new patch):
+// the line through the patches' mean grey levels, previous = gain * new + offset, fitted
+// as the principal axis with outliers (wrong matches, a mover's changing shade) trimmed
+// at three robust standard deviations. Means, not contrasts: a patch sampled between
+// pixels is smoother than one sampled on them, so contrast ratios are biased, means are
+// not. With too narrow a spread of means (under 10 grey levels) for a slope, the gain
+// is 1 and only the offset is measured.
+// At most kMaxExposurePairs pairs, evenly spaced, take part.
+double PatchMean(const cv::Mat& patch) {
+  uint32_t sum = 0;  // patches are small: no overflow
+  for (int r = 0; r < patch.rows; ++r) {
+    const uint8_t* p = patch.ptr<uint8_t>(r);
+    for (int c = 0; c < patch.cols; ++c) sum += p[c];
+  }
+  return static_cast<double>(sum) / static_cast<double>(patch.total());
+}
+
+std::optional<ExposureChange> ExposureChangeOfPatches(const std::vector<std::pair<const cv::Mat*, const cv::Mat*>>& pairs) {
+  constexpr size_t kMaxExposurePairs = 64;
+  std::vector<double> x, y;  // new, previous means
+  const size_t stride = std::max<size_t>(1, (pairs.size() + kMaxExposurePairs - 1) / kMaxExposurePairs);
+  for (size_t i = 0; i < pairs.size(); i += stride) {
+    const auto& [old_patch, new_patch] = pairs[i];
+    if (old_patch->type() != CV_8UC1 || new_patch->type() != CV_8UC1 || old_patch->empty() || new_patch->empty()) continue;
+    x.push_back(PatchMean(*new_patch));
+    y.push_back(PatchMean(*old_patch));
+  }
+  const size_t n = x.size();
+  if (n < 8) return std::nullopt;
+  ExposureChange c;
+  std::vector<double> d(n);
+  for (size_t i = 0; i < n; ++i) d[i] = x[i] - y[i];
+  c.mean_change = MedianOf(&d);
+  std::vector<uint8_t> in(n, 1);
+  for (int round = 0; round < 3; ++round) {
+    double sx = 0.0, sy = 0.0, m = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      if (!in[i]) continue;
+      sx += x[i];
+      sy += y[i];
+      m += 1.0;
+    }
+    if (m < 8.0) return std::nullopt;
+    const double mx = sx / m, my = sy / m;
+    double sxx = 0.0, sxy = 0.0, syy = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      if (!in[i]) continue;
+      sxx += (x[i] - mx) * (x[i] - mx);
+      sxy += (x[i] - mx) * (y[i] - my);
+      syy += (y[i] - my) * (y[i] - my);
+    }
+    // The principal axis (total least squares): both means carry the same noise, and
+    // regressing one on the other would pull the gain towards 0.
+    const double tls = sxy != 0.0 ? (syy - sxx + std::sqrt((syy - sxx) * (syy - sxx) + 4.0 * sxy * sxy)) / (2.0 * sxy) : 1.0;
+    c.gain = std::sqrt(sxx / m) >= 10.0 && tls > 0.0 ? tls : 1.0;
+    c.offset = my - c.gain * mx;
+    std::vector<double> r(n);  // vertical distances (the gain is near 1)
+    for (size_t i = 0; i < n; ++i) r[i] = std::abs(y[i] - (c.gain * x[i] + c.offset));
+    std::vector<double> rs = r;
+    const double sigma = std::max(1.0, 1.4826 * MedianOf(&rs));
+    for (size_t i = 0; i < n; ++i) in[i] = r[i] <= 3.0 * sigma;
+  }
+  return c;
+}
+
+// From the two whole images' means and standard deviations (consecutive images see
+// nearly the same scene); nullopt for a flat image.
+std::optional<ExposureChange> ExposureChangeOfImages(const cv::Mat& previous, const cv::Mat& image) {
+  cv::Scalar mp, sp, mn, sn;
+  cv::meanStdDev(previous, mp, sp);
+  cv::meanStdDev(image, mn, sn);
+  if (!(sn[0] > 1.0) || !(sp[0] > 1.0)) return std::nullopt;
+  ExposureChange c;
+  c.gain = sp[0] / sn[0];
+  c.offset = mp[0] - c.gain * mn[0];
+  c.mean_change = mn[0] - mp[0];
+  return c;
+}
+
+// `pyramid` (as cv::buildOpticalFlowPyramid made it: its levels, borders and
+// derivative levels) of the image gain * image + offset (saturated to 8 bits).
+std::vector<cv::Mat> ExposureCorrected(const std::vector<cv::Mat>& pyramid, double gain, double offset) {
+  cv::Mat corrected;
+  pyramid[0].convertTo(corrected, CV_8U, gain, offset);
+  cv::Size whole;
+  cv::Point ofs;
+  pyramid[0].locateROI(whole, ofs);
+  const bool derivatives = pyramid.size() > 1 && pyramid[1].type() != CV_8UC1;
+  const int levels = static_cast<int>(pyramid.size() / (derivatives ? 2 : 1)) - 1;
+  std::vector<cv::Mat> out;
+  cv::buildOpticalFlowPyramid(corrected, out, cv::Size(ofs.x, ofs.y), levels, derivatives);
+  return out;
 }
 
 // An image's pyramid for KLT: as built (OpenCV's KLT reads it) and as the project's KLT
@@ -109,7 +218,10 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   stats_ = TrackerStats();
   frame_index_ = frame_index;
   recently_lost_.clear();
-  const cv::Mat& image = pyramid[0];
+  // The image tracked: this one, or (exposure_compensation) its exposure-corrected copy.
+  std::vector<cv::Mat> corrected_pyramid;
+  const std::vector<cv::Mat>* tracked_pyramid = &pyramid;
+  cv::Mat image = pyramid[0];
   KltPyramid klt_pyramid;
   if (options_.klt_backend != "opencv") klt_pyramid = MakeKltPyramid(pyramid);
   if (prev_pyramid_.empty()) {
@@ -119,7 +231,7 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     prev_klt_pyramid_ = std::move(klt_pyramid);
     return;
   }
-  const LkPyramid prev_lk{prev_pyramid_, prev_klt_pyramid_}, lk{pyramid, klt_pyramid};
+  const LkPyramid prev_lk{prev_pyramid_, prev_klt_pyramid_};
 
   const float border = static_cast<float>(options_.border_px);
   // Nothing in tracks_ changes until the glitch test below has passed (a glitch image
@@ -161,90 +273,190 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
     next_pts.emplace_back(pred.x(), pred.y());
   }
 
-  // Stage 1: KLT from the predicted positions, forward then backward.
+  // Stage 1: KLT from the predicted positions, forward then backward, and the checks.
   stats_.fast_motion = options_.klt_fast_flow_px > 0.0 && last_median_flow_px_ > options_.klt_fast_flow_px;
   const int win_px = stats_.fast_motion ? options_.klt_fast_window_px : options_.klt_window_px;
   const int max_level = (stats_.fast_motion ? options_.klt_fast_levels : options_.klt_levels) - 1;
-  std::vector<uint8_t> status, back_status;
-  std::vector<cv::Point2f> back_pts;
-  if (!prev_pts.empty()) {
-    TrackLk(prev_lk, lk, prev_pts, &next_pts, &status, win_px, max_level, options_,
-            options_.klt_threads);
-    // Wide search: a failed prediction (a body that changed its motion) is retried
-    // from the previous position.
-    std::vector<size_t> retry;
-    std::vector<cv::Point2f> retry_prev, retry_next;
-    for (size_t k = 0; k < prev_pts.size(); ++k) {
-      const cv::Point2f guess_offset = next_pts[k] - prev_pts[k];
-      if (!status[k] && guess_offset.dot(guess_offset) > 1.0f) {
-        retry.push_back(k);
-        retry_prev.push_back(prev_pts[k]);
-        retry_next.push_back(prev_pts[k]);
-      }
-    }
-    if (!retry.empty()) {
-      std::vector<uint8_t> rs;
-      TrackLk(prev_lk, lk, retry_prev, &retry_next, &rs, win_px, max_level, options_, 1);
-      for (size_t r = 0; r < retry.size(); ++r) {
-        if (rs[r]) {
-          status[retry[r]] = 1;
-          next_pts[retry[r]] = retry_next[r];
-        }
-      }
-    }
-    back_pts = prev_pts;
-    back_status.assign(prev_pts.size(), 0);
-    // The backward pass starts where the track came from; with fewer levels it is faster
-    // but lets more false matches through (7.5 % of tracks on an unrelated image with 3
-    // levels, 10 % with 2, 11.6 % with 1: feature_tracker_test). Only the points the
-    // forward pass found go back (each point is tracked on its own: the same result).
-    std::vector<size_t> found;
-    std::vector<cv::Point2f> found_next, found_back;
-    for (size_t k = 0; k < prev_pts.size(); ++k) {
-      if (!status[k]) continue;
-      found.push_back(k);
-      found_next.push_back(next_pts[k]);
-      found_back.push_back(prev_pts[k]);
-    }
-    if (!found.empty()) {
-      std::vector<uint8_t> found_status;
-      TrackLk(lk, prev_lk, found_next, &found_back, &found_status, win_px,
-              options_.klt_backward_levels - 1, options_, options_.klt_threads);
-      for (size_t f = 0; f < found.size(); ++f) {
-        back_pts[found[f]] = found_back[f];
-        back_status[found[f]] = found_status[f];
-      }
-    }
-  }
-
   const float fb2 = static_cast<float>(options_.max_forward_backward_px *
                                        options_.max_forward_backward_px);
   const float a = static_cast<float>(options_.velocity_smoothing);
+  const std::vector<cv::Point2f> guesses = next_pts;
+  std::vector<uint8_t> status, back_status;
+  std::vector<cv::Point2f> back_pts;
   // Which tracks KLT matched (forward-backward, border, appearance).
-  std::vector<uint8_t> matched(prev_pts.size(), 0);
+  std::vector<uint8_t> matched;
   // Each patch has its own buffer: map points keep their track's latest patch (a shallow
   // copy), and a view into one per-image buffer would keep that whole buffer alive.
-  std::vector<cv::Mat> patches(prev_pts.size());
-  for (size_t k = 0; k < prev_pts.size(); ++k) {
-    const Track& t = tracks_[klt_index[k]];
-    const Eigen::Vector2f next(next_pts[k].x, next_pts[k].y);
-    const cv::Point2f d = back_pts[k] - prev_pts[k];
-    const bool ok = status[k] && back_status[k] && d.dot(d) <= fb2 && next.allFinite() &&
-                    InBorder(next, image, border);
-    matched[k] = ok && ExtractPatch(image, next, options_.patch_size, &patches[k]) &&
-                 (t.patch.empty() || PatchNcc(patches[k], t.patch) >= options_.min_patch_ncc) &&
-                 (t.anchor.empty() || PatchNcc(patches[k], t.anchor) >= options_.min_anchor_ncc);
-    if (t.age >= 3) {
-      ++stats_.established;
-      stats_.established_matched += matched[k];
+  std::vector<cv::Mat> patches;
+  auto match_all = [&](const LkPyramid& lk, const cv::Mat& img) {
+    next_pts = guesses;
+    status.clear();
+    back_status.clear();
+    back_pts.clear();
+    matched.assign(prev_pts.size(), 0);
+    patches.assign(prev_pts.size(), cv::Mat());
+    stats_.lost_forward = stats_.lost_backward = stats_.lost_consistency = stats_.lost_border = 0;
+    stats_.lost_appearance = stats_.established = stats_.established_matched = 0;
+    if (!prev_pts.empty()) {
+      TrackLk(prev_lk, lk, prev_pts, &next_pts, &status, win_px, max_level, options_,
+              options_.klt_threads);
+      // Wide search: a failed prediction (a body that changed its motion) is retried
+      // from the previous position.
+      std::vector<size_t> retry;
+      std::vector<cv::Point2f> retry_prev, retry_next;
+      for (size_t k = 0; k < prev_pts.size(); ++k) {
+        const cv::Point2f guess_offset = next_pts[k] - prev_pts[k];
+        if (!status[k] && guess_offset.dot(guess_offset) > 1.0f) {
+          retry.push_back(k);
+          retry_prev.push_back(prev_pts[k]);
+          retry_next.push_back(prev_pts[k]);
+        }
+      }
+      if (!retry.empty()) {
+        std::vector<uint8_t> rs;
+        TrackLk(prev_lk, lk, retry_prev, &retry_next, &rs, win_px, max_level, options_, 1);
+        for (size_t r = 0; r < retry.size(); ++r) {
+          if (rs[r]) {
+            status[retry[r]] = 1;
+            next_pts[retry[r]] = retry_next[r];
+          }
+        }
+      }
+      back_pts = prev_pts;
+      back_status.assign(prev_pts.size(), 0);
+      // The backward pass starts where the track came from; with fewer levels it is faster
+      // but lets more false matches through (7.5 % of tracks on an unrelated image with 3
+      // levels, 10 % with 2, 11.6 % with 1: feature_tracker_test). Only the points the
+      // forward pass found go back (each point is tracked on its own: the same result).
+      std::vector<size_t> found;
+      std::vector<cv::Point2f> found_next, found_back;
+      for (size_t k = 0; k < prev_pts.size(); ++k) {
+        if (!status[k]) continue;
+        found.push_back(k);
+        found_next.push_back(next_pts[k]);
+        found_back.push_back(prev_pts[k]);
+      }
+      if (!found.empty()) {
+        std::vector<uint8_t> found_status;
+        TrackLk(lk, prev_lk, found_next, &found_back, &found_status, win_px,
+                options_.klt_backward_levels - 1, options_, options_.klt_threads);
+        for (size_t f = 0; f < found.size(); ++f) {
+          back_pts[found[f]] = found_back[f];
+          back_status[found[f]] = found_status[f];
+        }
+      }
+    }
+
+    for (size_t k = 0; k < prev_pts.size(); ++k) {
+      const Track& t = tracks_[klt_index[k]];
+      const Eigen::Vector2f next(next_pts[k].x, next_pts[k].y);
+      const cv::Point2f d = back_pts[k] - prev_pts[k];
+      if (!status[k]) {
+        ++stats_.lost_forward;
+      } else if (!back_status[k]) {
+        ++stats_.lost_backward;
+      } else if (!(d.dot(d) <= fb2) || !next.allFinite()) {
+        ++stats_.lost_consistency;
+      } else if (!InBorder(next, img, border)) {
+        ++stats_.lost_border;
+      } else {
+        matched[k] = ExtractPatch(img, next, options_.patch_size, &patches[k]) &&
+                     (t.patch.empty() || PatchNcc(patches[k], t.patch) >= options_.min_patch_ncc) &&
+                     (t.anchor.empty() || PatchNcc(patches[k], t.anchor) >= options_.min_anchor_ncc);
+        stats_.lost_appearance += !matched[k];
+      }
+      if (t.age >= 3) {
+        ++stats_.established;
+        stats_.established_matched += matched[k];
+      }
+    }
+  };
+  auto is_glitch = [&]() {
+    return options_.glitch_max_survival > 0.0 && !last_rejected_ && stats_.established >= options_.glitch_min_tracks &&
+           static_cast<double>(stats_.established_matched) <
+               options_.glitch_max_survival * static_cast<double>(stats_.established);
+  };
+  match_all(LkPyramid{pyramid, klt_pyramid}, image);
+
+  // An exposure step (automatic exposure; KLT assumes constant brightness): detected on
+  // the matched tracks' patches against their templates, or by an image that looks like
+  // a glitch (its few matches may be wrong), and confirmed on the whole images. The first correction maps the image's
+  // mean and standard deviation onto the previous image's (the matches under a step are
+  // off target, their patches a poor measure); the image is tracked again, and the
+  // remaining change is measured on the new, aligned matches and undone, at most
+  // kMaxCorrections times in all. The last correction stands if it keeps at least as
+  // many established tracks as the image as it came, else none does.
+  if (options_.exposure_compensation) {
+    constexpr size_t kMinExposurePairs = 20;
+    constexpr int kMaxCorrections = 3;
+    auto measure = [&]() -> std::optional<ExposureChange> {
+      std::vector<std::pair<const cv::Mat*, const cv::Mat*>> pairs;  // (template, new patch)
+      for (size_t k = 0; k < prev_pts.size(); ++k) {
+        const Track& t = tracks_[klt_index[k]];
+        if (matched[k] && !t.patch.empty()) pairs.emplace_back(&t.patch, &patches[k]);
+      }
+      if (pairs.size() >= kMinExposurePairs) return ExposureChangeOfPatches(pairs);
+      return std::nullopt;
+    };
+    auto significant = [&](const ExposureChange& c) {
+      return std::abs(c.mean_change) > options_.exposure_min_mean_change ||
+             std::abs(c.gain - 1.0) > options_.exposure_min_contrast_change;
+    };
+    const std::optional<ExposureChange> on_patches = measure();
+    std::optional<ExposureChange> change;
+    if ((on_patches && significant(*on_patches)) || is_glitch()) {
+      change = ExposureChangeOfImages(prev_pyramid_[0], pyramid[0]);
+      // The whole images must show the step too: an image that looks like a glitch
+      // without a change of exposure is one, and patches that disagree with the whole
+      // images are wrong matches, not an exposure step.
+      if (change && !significant(*change)) change.reset();
+    }
+    if (change) {
+      // The image as it came, in case no correction does better.
+      struct Attempt {
+        std::vector<cv::Point2f> next_pts, back_pts;
+        std::vector<uint8_t> status, back_status, matched;
+        std::vector<cv::Mat> patches;
+        TrackerStats stats;
+        KltPyramid klt;
+      };
+      Attempt as_it_came{next_pts, back_pts, status, back_status, matched, patches, stats_, std::move(klt_pyramid)};
+      const bool glitch_as_it_came = is_glitch();
+      double gain = 1.0, offset = 0.0;
+      for (int n = 0; n < kMaxCorrections && change && (n == 0 || significant(*change)); ++n) {
+        // The change measured on the current image, undone on top of its own correction.
+        gain = change->gain * gain;
+        offset = change->gain * offset + change->offset;
+        corrected_pyramid = ExposureCorrected(pyramid, gain, offset);
+        klt_pyramid = KltPyramid();
+        if (options_.klt_backend != "opencv") klt_pyramid = MakeKltPyramid(corrected_pyramid);
+        match_all(LkPyramid{corrected_pyramid, klt_pyramid}, corrected_pyramid[0]);
+        change = measure();
+      }
+      const bool better = !is_glitch() && (glitch_as_it_came || stats_.established_matched >=
+                                                                      as_it_came.stats.established_matched);
+      if (better) {
+        tracked_pyramid = &corrected_pyramid;
+        image = corrected_pyramid[0];
+        stats_.exposure_corrected = true;
+        stats_.exposure_gain = gain;
+        stats_.exposure_offset = offset;
+      } else {
+        next_pts = std::move(as_it_came.next_pts);
+        back_pts = std::move(as_it_came.back_pts);
+        status = std::move(as_it_came.status);
+        back_status = std::move(as_it_came.back_status);
+        matched = std::move(as_it_came.matched);
+        patches = std::move(as_it_came.patches);
+        stats_ = as_it_came.stats;
+        klt_pyramid = std::move(as_it_came.klt);
+      }
     }
   }
 
   // A glitch image: nearly every established track lost at once. Nothing changes; the
   // last good image stays the reference.
-  if (options_.glitch_max_survival > 0.0 && !last_rejected_ && stats_.established >= options_.glitch_min_tracks &&
-      static_cast<double>(stats_.established_matched) <
-          options_.glitch_max_survival * static_cast<double>(stats_.established)) {
+  if (is_glitch()) {
     const TrackerStats seen = stats_;
     stats_ = TrackerStats();
     stats_.rejected = true;
@@ -341,7 +553,7 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
 
   tracks_ = std::move(next_tracks);
   EnforceUnicity();
-  prev_pyramid_ = pyramid;
+  prev_pyramid_ = *tracked_pyramid;
   prev_klt_pyramid_ = std::move(klt_pyramid);
   DetectNew(image, frame_index);
 }

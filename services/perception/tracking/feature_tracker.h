@@ -82,6 +82,17 @@ struct TrackerOptions {
   // tracked from the last good one. Not twice in a row (a real change of view is taken).
   double glitch_max_survival = 0.2;    // established tracks matched below this share: glitch (0 = off)
   int glitch_min_tracks = 40;          // ... only with at least this many established tracks (count)
+  // An exposure step (automatic exposure, a rendered sequence's): KLT assumes constant
+  // brightness, and under a step it matches few tracks (the image looks like a glitch)
+  // or matches them off target. The change is measured on the matched tracks' patches
+  // against their templates (medians of the contrast ratios and mean differences; on
+  // the whole images when too few matched); when the mean moves or the contrast changes
+  // by more than these, the image is mapped linearly onto the previous exposure and
+  // tracked again, and the attempt that keeps more established tracks stands. Later
+  // images are tracked from the corrected one.
+  bool exposure_compensation = true;
+  double exposure_min_mean_change = 5.0;      // mean grey level change that triggers it (grey levels)
+  double exposure_min_contrast_change = 0.05; // ... or relative change of the standard deviation (fraction)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(max_features, 0);
@@ -127,6 +138,8 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION_GT(fallback_radius, 0.0);
     MBSLAM_CHECK_OPTION(glitch_max_survival >= 0.0 && glitch_max_survival < 1.0);
     MBSLAM_CHECK_OPTION_GE(glitch_min_tracks, 1);
+    MBSLAM_CHECK_OPTION_GE(exposure_min_mean_change, 0.0);
+    MBSLAM_CHECK_OPTION_GE(exposure_min_contrast_change, 0.0);
     return true;
   }
   template <typename V>
@@ -177,6 +190,11 @@ struct TrackerOptions {
     v("glitch_max_survival", &glitch_max_survival,
       "established tracks matched below this share: the image is a glitch, rejected, tracks kept (0 = off)");
     v("glitch_min_tracks", &glitch_min_tracks, "glitch test only with this many established tracks (count)");
+    v("exposure_compensation", &exposure_compensation,
+      "an exposure step (measured on the matched patches) is undone and the image tracked again");
+    v("exposure_min_mean_change", &exposure_min_mean_change, "mean change that triggers the compensation (grey levels)");
+    v("exposure_min_contrast_change", &exposure_min_contrast_change,
+      "relative contrast change that triggers the compensation (fraction)");
   }
 };
 
@@ -210,6 +228,12 @@ struct WarpAlignStats {
 struct TrackerStats {
   int tracked = 0;        // matched by KLT
   int lost = 0;           // failed KLT / checks
+  // Why KLT matches were refused (each refused match counts once, at its first failed check).
+  int lost_forward = 0;   // the forward pass did not converge (or left the image)
+  int lost_backward = 0;  // the backward pass did not converge
+  int lost_consistency = 0;  // forward-backward disagreement above max_forward_backward_px
+  int lost_border = 0;    // the match fell within the border
+  int lost_appearance = 0;  // the patch did not match the template or the anchor (NCC)
   int occluded = 0;       // kept behind hulls
   int recovered = 0;      // re-found by guided matching
   int created = 0;        // new features
@@ -218,6 +242,8 @@ struct TrackerStats {
   bool fast_motion = false;    // KLT ran with the fast-motion settings
   double median_flow_px = 0.0; // median motion of the tracks matched in this image (px)
   bool rejected = false;       // the image was a glitch (see glitch_max_survival): nothing changed
+  bool exposure_corrected = false;  // tracked after undoing an exposure change (exposure_compensation)
+  double exposure_gain = 1.0, exposure_offset = 0.0;  // the correction: corrected = gain * image + offset
   int established = 0;         // tracks of age >= 3 tried in this image
   int established_matched = 0;
 };

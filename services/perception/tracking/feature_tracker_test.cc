@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <iostream>
 #include <map>
+#include <string>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -153,6 +156,70 @@ TEST(FeatureTracker, GlitchImageIsRejectedAndTracksSurviveIt) {
   for (int f = 0; f < 4; ++f) plain.TrackFrame(Pyramid(Shift(base, f, 0)), f, {});
   plain.TrackFrame(Pyramid(Texture(320, 240, 77)), 4, {});
   EXPECT_FALSE(plain.stats().rejected);
+}
+
+// An exposure step (a camera's automatic exposure, a rendered sequence's) breaks KLT's
+// constant brightness: without the compensation most tracks are matched off target
+// (a larger step makes the image look like a glitch). With it the step is undone (mean and contrast mapped onto the previous
+// image's) and the tracks follow the image's motion; the next image, back at the old
+// exposure, is tracked from the corrected one.
+TEST(FeatureTracker, ExposureStepIsUndoneInsteadOfRejected) {
+  // Texture on shading that varies across the image, as in a real scene (the step is
+  // measured on how the patches' mean grey levels map).
+  cv::Mat shading(240, 320, CV_8UC1), base;
+  for (int r = 0; r < shading.rows; ++r) {
+    for (int c = 0; c < shading.cols; ++c) shading.at<uint8_t>(r, c) = static_cast<uint8_t>(70 + 50 * std::sin(0.02 * c) * std::cos(0.015 * r));
+  }
+  cv::addWeighted(Texture(320, 240, 5), 0.4, shading, 1.0, 0.0, base);
+  // A step KLT survives off target, and one it does not survive (the whole images
+  // measure that one).
+  for (const auto& [step_gain, step_offset] : {std::pair{0.7, 60.0}, std::pair{0.4, 130.0}})
+  for (bool retry : {false, true}) {
+    SCOPED_TRACE(std::string(retry ? "retry" : "no retry") + ", gain " + std::to_string(step_gain));
+    auto exposed = [&](const cv::Mat& img) {
+      cv::Mat out;
+      img.convertTo(out, CV_8U, step_gain, step_offset);
+      return out;
+    };
+    TrackerOptions options;
+    options.exposure_compensation = retry;
+    FeatureTracker tracker(options);
+    for (int f = 0; f < 4; ++f) tracker.TrackFrame(Pyramid(Shift(base, f, 0)), f, {});
+    std::map<int64_t, Eigen::Vector2f> before;
+    for (const Track& t : tracker.tracks()) before[t.id] = t.uv;
+    ASSERT_GT(before.size(), 100u);
+    tracker.TrackFrame(Pyramid(exposed(Shift(base, 4, 0))), 4, {});
+    const TrackerStats& s = tracker.stats();
+    int followed = 0;
+    for (const Track& t : tracker.tracks()) {
+      auto it = before.find(t.id);
+      if (it != before.end() && std::abs(t.uv.x() - it->second.x() - 1.0f) < 0.3f &&
+          std::abs(t.uv.y() - it->second.y()) < 0.3f) {
+        ++followed;
+      }
+    }
+    if (!retry) {
+      // Off target, or lost and the image rejected as a glitch.
+      EXPECT_FALSE(s.exposure_corrected);
+      EXPECT_LT(followed, static_cast<int>(0.3 * before.size()));
+      if (step_gain < 0.5) {
+        EXPECT_TRUE(s.rejected);
+      }
+      std::cerr << "without compensation, gain " << step_gain << ": rejected " << s.rejected << ", "
+                << s.established_matched << " of " << s.established << " matched, " << followed << " on target\n";
+      continue;
+    }
+    EXPECT_FALSE(s.rejected);
+    EXPECT_TRUE(s.exposure_corrected);
+    EXPECT_NEAR(s.exposure_gain, 1.0 / step_gain, 0.05 / step_gain);
+    EXPECT_NEAR(s.exposure_offset, -step_offset / step_gain, 5.0 / step_gain);
+    EXPECT_GT(followed, static_cast<int>(0.8 * before.size()));
+    // Back to the old exposure: tracked from the corrected image, no retry needed.
+    tracker.TrackFrame(Pyramid(Shift(base, 5, 0)), 5, {});
+    EXPECT_FALSE(tracker.stats().rejected);
+    EXPECT_FALSE(tracker.stats().exposure_corrected);
+    EXPECT_GT(tracker.stats().tracked, static_cast<int>(0.8 * before.size()));
+  }
 }
 
 // Fast image motion switches KLT to its wider window and extra level for the next image,
