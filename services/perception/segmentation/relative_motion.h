@@ -90,6 +90,30 @@ inline double EpipolarDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& 
   return x_n.homogeneous().dot(l) / norm;
 }
 
+// EpipolarDistance(E, x_r, x_n) for E = [t]x R, and its derivative w.r.t. a left
+// perturbation of the motion, Exp([v; w]) * (R, t) (the twist order of rigid3.h). To
+// first order the perturbation moves E by [v]x R + [w]x E, so with a = R x_r and
+// l = E x_r the line moves by v x a + w x l, and d(distance) = [a x g; l x g] . [v; w],
+// g = (x_n - (distance / |l_xy|) l_xy) / |l_xy| (homogeneous x_n, l_xy = (l_x, l_y, 0)).
+// Zero, with a zero derivative, for a degenerate line, as EpipolarDistance.
+inline double EpipolarDistanceAndJacobian(const Eigen::Matrix3d& R, const Eigen::Matrix3d& E,
+                                          const Eigen::Vector2d& x_r, const Eigen::Vector2d& x_n,
+                                          Eigen::Matrix<double, 1, 6>* J) {
+  const Eigen::Vector3d xr = x_r.homogeneous();
+  const Eigen::Vector3d l = E * xr;
+  const double norm = std::sqrt(l.x() * l.x() + l.y() * l.y());
+  if (norm < 1e-15) {
+    J->setZero();
+    return 0.0;
+  }
+  const Eigen::Vector3d xn = x_n.homogeneous();
+  const double d = xn.dot(l) / norm;
+  const Eigen::Vector3d g = (xn - (d / norm) * Eigen::Vector3d(l.x(), l.y(), 0.0)) / norm;
+  J->head<3>() = (R * xr).cross(g).transpose();
+  J->tail<3>() = l.cross(g).transpose();
+  return d;
+}
+
 }  // namespace mbslam
 
 #endif  // MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_RELATIVE_MOTION_H_

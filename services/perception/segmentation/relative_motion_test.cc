@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 namespace mbslam {
@@ -17,6 +19,36 @@ void MakeScene(const Rigid3d& cam_n_from_cam_r, int n, double noise_norm, std::m
     xr->push_back(p.hnormalized() + Eigen::Vector2d(g(*rng), g(*rng)));
     xn->push_back(q.hnormalized() + Eigen::Vector2d(g(*rng), g(*rng)));
   }
+}
+
+// The analytic derivative of the epipolar distance against central differences of
+// EpipolarDistance over left perturbations, on random motions and points.
+TEST(RelativeMotion, EpipolarDistanceJacobianMatchesNumeric) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst = 0.0;
+  for (int trial = 0; trial < 200; ++trial) {
+    Vector6d xi;
+    for (int k = 0; k < 6; ++k) xi[k] = (k < 3 ? 0.5 : 0.2) * u(rng);
+    Rigid3d T = Rigid3d::Exp(xi);
+    T.translation.normalize();
+    const Eigen::Vector2d xr(0.5 * u(rng), 0.4 * u(rng)), xn(0.5 * u(rng), 0.4 * u(rng));
+    const Eigen::Matrix3d R = T.RotationMatrix();
+    Eigen::Matrix<double, 1, 6> J;
+    const double d = EpipolarDistanceAndJacobian(R, Hat(T.translation) * R, xr, xn, &J);
+    EXPECT_NEAR(d, EpipolarDistance(Hat(T.translation) * R, xr, xn), 1e-14);
+    constexpr double h = 1e-6;
+    for (int k = 0; k < 6; ++k) {
+      Vector6d dxi = Vector6d::Zero();
+      dxi[k] = h;
+      const Rigid3d Tp = Rigid3d::Exp(dxi) * T, Tm = Rigid3d::Exp(-dxi) * T;
+      const double numeric = (EpipolarDistance(Hat(Tp.translation) * Tp.RotationMatrix(), xr, xn) -
+                              EpipolarDistance(Hat(Tm.translation) * Tm.RotationMatrix(), xr, xn)) /
+                             (2.0 * h);
+      worst = std::max(worst, std::abs(numeric - J[k]) / std::max(1.0, std::abs(numeric)));
+    }
+  }
+  EXPECT_LT(worst, 1e-6);
 }
 
 TEST(RelativeMotion, RecoversDirectionAndRotation) {
