@@ -62,17 +62,29 @@ TEST(PerceptionCoreTest, WideKltWindowRuns) {
   SUCCEED();
 }
 
+// A core (BA in the calling thread) that has tracked five images of a texture moving
+// 2 px per image: images 0-4, Shifted(base, 2 k).
+struct WarmCore {
+  CoreOptions options = [] {
+    CoreOptions o;
+    o.slam.background_ba = false;
+    return o;
+  }();
+  Counters counters;
+  StageTimers timers;
+  PerceptionCore core{options, &counters, &timers};
+  cv::Mat base = Texture(640, 480, 4);
+  std::shared_ptr<const CameraIntrinsics> K = Intrinsics();
+  WarmCore() {
+    for (int k = 0; k < 5; ++k) core.ProcessFrame(Frame(Shifted(base, 2.0 * k), k, K));
+  }
+};
+
 // A glitch image between good ones is rejected and counted, with no pose, and the images
 // after it are processed as if it had not come.
 TEST(PerceptionCoreTest, GlitchImageIsCountedAndSkipped) {
-  CoreOptions options;
-  options.slam.background_ba = false;
-  Counters counters;
-  StageTimers timers;
-  PerceptionCore core(options, &counters, &timers);
-  const cv::Mat base = Texture(640, 480, 4);
-  const auto K = Intrinsics();
-  for (int k = 0; k < 5; ++k) core.ProcessFrame(Frame(Shifted(base, 2.0 * k), k, K));
+  WarmCore w;
+  auto& [options, counters, timers, core, base, K] = w;
   const FrameResult r = core.ProcessFrame(Frame(Texture(640, 480, 99), 5, K));
   EXPECT_EQ(counters.Get(counter::kImageRejectedGlitch), 1);
   EXPECT_NE(r.camera_pose.tracking_state, TrackingState::kOk);
@@ -85,14 +97,8 @@ TEST(PerceptionCoreTest, GlitchImageIsCountedAndSkipped) {
 
 // An exposure step is undone and counted, not rejected as a glitch: the tracks follow it.
 TEST(PerceptionCoreTest, ExposureStepIsCountedAndTracked) {
-  CoreOptions options;
-  options.slam.background_ba = false;
-  Counters counters;
-  StageTimers timers;
-  PerceptionCore core(options, &counters, &timers);
-  const cv::Mat base = Texture(640, 480, 4);
-  const auto K = Intrinsics();
-  for (int k = 0; k < 5; ++k) core.ProcessFrame(Frame(Shifted(base, 2.0 * k), k, K));
+  WarmCore w;
+  auto& [options, counters, timers, core, base, K] = w;
   cv::Mat brighter;
   Shifted(base, 10.0).convertTo(brighter, CV_8U, 0.5, 110.0);
   const FrameResult r = core.ProcessFrame(Frame(brighter, 5, K));

@@ -12,6 +12,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "common/util/parallel_for.h"
+#include "common/util/statistics.h"
 #include "services/perception/geometry/patch_warp.h"
 #include "services/perception/geometry/polygon.h"
 #include "services/perception/tracking/disc_stamp.h"
@@ -62,11 +63,6 @@ struct ExposureChange {
   double mean_change = 0.0;
 };
 
-double MedianOf(std::vector<double>* v) {
-  std::nth_element(v->begin(), v->begin() + static_cast<std::ptrdiff_t>(v->size() / 2), v->end());
-  return (*v)[v->size() / 2];
-}
-
 // From the same scene points seen in both images (a track's template and its new patch):
 // the line through the patches' mean grey levels, previous = gain * new + offset, fitted
 // as the principal axis with outliers (wrong matches, a mover's changing shade) trimmed
@@ -99,7 +95,7 @@ std::optional<ExposureChange> ExposureChangeOfPatches(const std::vector<std::pai
   ExposureChange c;
   std::vector<double> d(n);
   for (size_t i = 0; i < n; ++i) d[i] = x[i] - y[i];
-  c.mean_change = MedianOf(&d);
+  c.mean_change = Median(d);
   std::vector<uint8_t> in(n, 1);
   for (int round = 0; round < 3; ++round) {
     double sx = 0.0, sy = 0.0, m = 0.0;
@@ -125,8 +121,7 @@ std::optional<ExposureChange> ExposureChangeOfPatches(const std::vector<std::pai
     c.offset = my - c.gain * mx;
     std::vector<double> r(n);  // vertical distances (the gain is near 1)
     for (size_t i = 0; i < n; ++i) r[i] = std::abs(y[i] - (c.gain * x[i] + c.offset));
-    std::vector<double> rs = r;
-    const double sigma = std::max(1.0, 1.4826 * MedianOf(&rs));
+    const double sigma = std::max(1.0, 1.4826 * Median(r));
     for (size_t i = 0; i < n; ++i) in[i] = r[i] <= 3.0 * sigma;
   }
   return c;
