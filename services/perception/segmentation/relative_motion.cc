@@ -88,17 +88,26 @@ Matrix6d EpipolarCovariance(const Rigid3d& T, const std::vector<Eigen::Vector2d>
 
 // Gauss-Newton / Levenberg-Marquardt on the inliers' epipolar distances over a left
 // perturbation of the motion; the translation is renormalised (5 effective dof).
+// With front_margin >= 0, each inlier also has the one-sided residual
+// min(0, flow + front_margin) of its flow along the direction of positive depth
+// (DepthFlowOf): the epipolar distances cannot tell a point in front from one behind.
 Rigid3d RefineMotion(const Rigid3d& initial, const std::vector<Eigen::Vector2d>& x_r,
                      const std::vector<Eigen::Vector2d>& x_n, const std::vector<uint8_t>& inliers,
-                     double huber) {
+                     double huber, double front_margin = -1.0) {
   Rigid3d T = initial;
+  auto robust = [huber](double r) { return r <= huber ? r * r : 2.0 * huber * r - huber * huber; };
+  auto behind = [&](const Eigen::Matrix3d& R, const Eigen::Vector3d& t, size_t i) {
+    const DepthFlow df = DepthFlowOf(R, t, x_r[i], x_n[i]);
+    return df.valid ? std::min(0.0, df.flow + front_margin) : 0.0;
+  };
   auto cost_of = [&](const Rigid3d& M) {
-    const Eigen::Matrix3d E = Hat(M.translation) * M.RotationMatrix();
+    const Eigen::Matrix3d R = M.RotationMatrix();
+    const Eigen::Matrix3d E = Hat(M.translation) * R;
     double c = 0.0;
     for (size_t i = 0; i < x_r.size(); ++i) {
       if (!inliers[i]) continue;
-      const double r = std::abs(EpipolarDistance(E, x_r[i], x_n[i]));
-      c += r <= huber ? r * r : 2.0 * huber * r - huber * huber;
+      c += robust(std::abs(EpipolarDistance(E, x_r[i], x_n[i])));
+      if (front_margin >= 0.0) c += robust(-behind(R, M.translation, i));
     }
     return c;
   };
@@ -116,6 +125,30 @@ Rigid3d RefineMotion(const Rigid3d& initial, const std::vector<Eigen::Vector2d>&
       const double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
       AddOuterUpper(J, w, &JtJ);
       Jtr += (w * r) * J.transpose();
+    }
+    if (front_margin >= 0.0) {
+      // The one-sided residuals' derivative by forward differences (only points behind).
+      constexpr double kStep = 1e-7;
+      Eigen::Matrix3d Rk[6];
+      Eigen::Vector3d tk[6];
+      for (int k = 0; k < 6; ++k) {
+        const Rigid3d Tk = Rigid3d::Exp(kStep * Vector6d::Unit(k)) * T;
+        Rk[k] = Tk.RotationMatrix();
+        tk[k] = Tk.translation;
+      }
+      for (size_t i = 0; i < x_r.size(); ++i) {
+        if (!inliers[i]) continue;
+        const double r = behind(R0, T.translation, i);
+        if (r >= 0.0) continue;
+        Eigen::Matrix<double, 1, 6> J;
+        for (int k = 0; k < 6; ++k) {
+          const DepthFlow df = DepthFlowOf(Rk[k], tk[k], x_r[i], x_n[i]);
+          J[k] = df.valid ? (df.flow + front_margin - r) / kStep : 0.0;
+        }
+        const double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
+        AddOuterUpper(J, w, &JtJ);
+        Jtr += (w * r) * J.transpose();
+      }
     }
     FillLower(&JtJ);
     Matrix6d A = JtJ;
@@ -326,14 +359,52 @@ Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
     }
     T = RefineMotion(T, x_r, x_n, *inliers, options.sigma_px / focal_px * 2.0);
   }
-  const Eigen::Matrix3d Em = Hat(T.translation) * T.RotationMatrix();
-  for (size_t i = 0; i < n; ++i) {
-    (*inliers)[i] = std::abs(EpipolarDistance(Em, x_r[i], x_n[i])) <= thresh ? 1 : 0;
+  auto count_inliers = [&](const Rigid3d& M, std::vector<uint8_t>* in) {
+    const Eigen::Matrix3d Em = Hat(M.translation) * M.RotationMatrix();
+    int count = 0;
+    for (size_t i = 0; i < n; ++i) {
+      (*in)[i] = std::abs(EpipolarDistance(Em, x_r[i], x_n[i])) <= thresh ? 1 : 0;
+      count += (*in)[i];
+    }
+    return count;
+  };
+  int e_count = count_inliers(T, inliers);
+  if (options.cheirality_refine) {
+    // The epipolar distances hardly see a rotation that slides every point along its
+    // epipolar line (about an axis across the translation, for a narrow field of view):
+    // it moves near points one way and far ones the other, and may put a whole depth
+    // layer behind the cameras while fitting them all. cv::recoverPose counts only
+    // points nearer than 50 baselines, so it does not see that either. When too many
+    // inliers are behind, the motion is refined with them held in front.
+    const double margin = options.front_margin_px / focal_px;
+    auto count_behind = [&](const Rigid3d& M, const std::vector<uint8_t>& in) {
+      const Eigen::Matrix3d R = M.RotationMatrix();
+      int count = 0;
+      for (size_t i = 0; i < n; ++i) {
+        if (!in[i]) continue;
+        const DepthFlow df = DepthFlowOf(R, M.translation, x_r[i], x_n[i]);
+        count += df.valid && df.flow < -margin;
+      }
+      return count;
+    };
+    const int behind = count_behind(T, *inliers);
+    if (behind > options.max_behind_share * e_count) {
+      const Rigid3d C = RefineMotion(T, x_r, x_n, *inliers, options.sigma_px / focal_px * 2.0, margin);
+      std::vector<uint8_t> c_inliers(n, 0);
+      const int c_count = count_inliers(C, &c_inliers);
+      const int c_behind = count_behind(C, c_inliers);
+      const bool keep = c_count >= options.front_keep_ratio * e_count && c_behind < behind;
+      MBSLAM_LOG(DEBUG) << "two-view: " << behind << " of " << e_count << " inliers behind; held in front: "
+                        << c_behind << " of " << c_count << (keep ? " (kept)" : " (not kept)");
+      if (keep) {
+        T = C;
+        *inliers = std::move(c_inliers);
+        e_count = c_count;
+      }
+    }
   }
   // A pure rotation satisfies every epipolar constraint: prefer the simpler model when
   // it explains (nearly) as many points.
-  int e_count = 0;
-  for (uint8_t v : *inliers) e_count += v;
   MBSLAM_LOG(DEBUG) << "two-view: essential inliers " << e_count << " t " << T.translation.transpose();
   if (rot_count >= 0.95 * e_count) return rotation_only();
   motion->cam_n_from_cam_r = T;

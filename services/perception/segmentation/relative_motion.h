@@ -48,6 +48,10 @@ struct TwoViewOptions {
   double min_parallax_px = 1.0;    // median rotation-compensated flow below this = pure rotation, no essential fit (px)
   int min_points = 12;             // fewer correspondences: no estimate (count)
   int ransac_max_iterations = 1000;  // RANSAC iterations at most (count; bounds the cost at low inlier ratios)
+  bool cheirality_refine = true;   // refine a motion that puts too many inliers behind the cameras with them held in front
+  double front_margin_px = 2.0;    // flow against the direction of positive depth tolerated as noise (px)
+  double max_behind_share = 0.5;   // inliers behind (beyond the margin) above this share trigger the refinement
+  double front_keep_ratio = 0.9;   // the refined motion is kept if it keeps this share of the inliers (and fewer behind)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(sigma_px, 0.0);
@@ -56,6 +60,9 @@ struct TwoViewOptions {
     MBSLAM_CHECK_OPTION_GE(min_parallax_px, 0.0);
     MBSLAM_CHECK_OPTION_GE(min_points, 8);
     MBSLAM_CHECK_OPTION_GE(ransac_max_iterations, 1);
+    MBSLAM_CHECK_OPTION_GE(front_margin_px, 0.0);
+    MBSLAM_CHECK_OPTION(max_behind_share >= 0.0 && max_behind_share <= 1.0);
+    MBSLAM_CHECK_OPTION(front_keep_ratio >= 0.0 && front_keep_ratio <= 1.0);
     return true;
   }
   template <typename V>
@@ -66,6 +73,11 @@ struct TwoViewOptions {
     v("min_parallax_px", &min_parallax_px, "median rotation-compensated flow below this = pure rotation (px)");
     v("min_points", &min_points, "fewest correspondences for an estimate (count)");
     v("ransac_max_iterations", &ransac_max_iterations, "RANSAC iterations at most (count)");
+    v("cheirality_refine", &cheirality_refine,
+      "refine a motion that puts too many inliers behind the cameras with them held in front");
+    v("front_margin_px", &front_margin_px, "flow against the direction of positive depth tolerated as noise (px)");
+    v("max_behind_share", &max_behind_share, "inliers behind (beyond the margin) above this share trigger the refinement");
+    v("front_keep_ratio", &front_keep_ratio, "the refined motion is kept if it keeps this share of the inliers (and fewer behind)");
   }
 };
 
@@ -112,6 +124,33 @@ inline double EpipolarDistanceAndJacobian(const Eigen::Matrix3d& R, const Eigen:
   J->head<3>() = (R * xr).cross(g).transpose();
   J->tail<3>() = l.cross(g).transpose();
   return d;
+}
+
+// Where a static point's image moves under the motion x_n = R x_r + t: it leaves the
+// rotated position p = (R x_r) normalised along u = (t_xy - t_z p) / |t_xy - t_z p|, by
+// |t_xy - t_z p| / (z' + t_z) for its depth z' after rotation. `flow` is x_n's signed
+// displacement along u, so a point in front of both cameras has flow >= 0 (up to noise).
+struct DepthFlow {
+  bool valid = false;          // false: R x_r behind the camera, or the point on the epipole
+  Eigen::Vector2d p = Eigen::Vector2d::Zero();  // rotation-compensated position (normalised)
+  Eigen::Vector2d u = Eigen::Vector2d::Zero();  // unit flow direction of positive depth
+  double dir_norm = 0.0;       // |t_xy - t_z p|
+  double flow = 0.0;           // (x_n - p) . u (normalised units)
+};
+
+inline DepthFlow DepthFlowOf(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Eigen::Vector2d& x_r,
+                             const Eigen::Vector2d& x_n) {
+  DepthFlow out;
+  const Eigen::Vector3d rx = R * x_r.homogeneous();
+  if (rx.z() <= 1e-9) return out;
+  out.p = rx.hnormalized();
+  const Eigen::Vector2d dir = t.head<2>() - t.z() * out.p;
+  out.dir_norm = dir.norm();
+  if (out.dir_norm < 1e-12) return out;
+  out.u = dir / out.dir_norm;
+  out.flow = (x_n - out.p).dot(out.u);
+  out.valid = true;
+  return out;
 }
 
 }  // namespace mbslam

@@ -47,14 +47,13 @@ PairTerms Evaluate(const Eigen::Vector2d& x_r, const Eigen::Vector2d& x_n, const
   }
   out.d_epi = std::abs(EpipolarDistance(m.E, x_r, x_n));
   // Static point at depth z' (after rotation): x_n = p' + (t_xy - t_z p') / (z' + t_z).
-  const Eigen::Vector2d dir_raw = m.t.head<2>() - m.t.z() * p;
-  const double dir_norm = dir_raw.norm();
-  if (dir_norm < 1e-12) {  // the point sits on the epipole: no flow information
+  const DepthFlow df = DepthFlowOf(m.R, m.t, x_r, x_n);
+  if (!df.valid) {  // the point sits on the epipole: no flow information
     out.p_fvb = 1.0;
     return out;
   }
-  const Eigen::Vector2d u = dir_raw / dir_norm;
-  out.flow = (x_n - p).dot(u);
+  const double dir_norm = df.dir_norm;
+  out.flow = df.flow;
   double lo = 0.0;
   double hi = std::numeric_limits<double>::infinity();
   if (scale_known) {
