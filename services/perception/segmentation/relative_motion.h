@@ -131,26 +131,27 @@ inline double EpipolarDistanceAndJacobian(const Eigen::Matrix3d& R, const Eigen:
 // |t_xy - t_z p| / (z' + t_z) for its depth z' after rotation. `flow` is x_n's signed
 // displacement along u, so a point in front of both cameras has flow >= 0 (up to noise).
 struct DepthFlow {
-  bool valid = false;          // false: R x_r behind the camera, or the point on the epipole
-  Eigen::Vector2d p = Eigen::Vector2d::Zero();  // rotation-compensated position (normalised)
-  Eigen::Vector2d u = Eigen::Vector2d::Zero();  // unit flow direction of positive depth
-  double dir_norm = 0.0;       // |t_xy - t_z p|
-  double flow = 0.0;           // (x_n - p) . u (normalised units)
+  bool valid = false;     // false: R x_r behind the camera, or the point on the epipole
+  double dir_norm = 0.0;  // |t_xy - t_z p|
+  double flow = 0.0;      // (x_n - p) . u (normalised units)
 };
+
+// From the rotated position p itself (for callers that have it already).
+inline DepthFlow DepthFlowAt(const Eigen::Vector2d& p, const Eigen::Vector3d& t, const Eigen::Vector2d& x_n) {
+  DepthFlow out;
+  const Eigen::Vector2d dir = t.head<2>() - t.z() * p;
+  out.dir_norm = dir.norm();
+  if (out.dir_norm < 1e-12) return out;
+  out.flow = (x_n - p).dot(dir / out.dir_norm);
+  out.valid = true;
+  return out;
+}
 
 inline DepthFlow DepthFlowOf(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Eigen::Vector2d& x_r,
                              const Eigen::Vector2d& x_n) {
-  DepthFlow out;
   const Eigen::Vector3d rx = R * x_r.homogeneous();
-  if (rx.z() <= 1e-9) return out;
-  out.p = rx.hnormalized();
-  const Eigen::Vector2d dir = t.head<2>() - t.z() * out.p;
-  out.dir_norm = dir.norm();
-  if (out.dir_norm < 1e-12) return out;
-  out.u = dir / out.dir_norm;
-  out.flow = (x_n - out.p).dot(out.u);
-  out.valid = true;
-  return out;
+  if (rx.z() <= 1e-9) return DepthFlow();
+  return DepthFlowAt(rx.hnormalized(), t, x_n);
 }
 
 }  // namespace mbslam

@@ -47,7 +47,7 @@ PairTerms Evaluate(const Eigen::Vector2d& x_r, const Eigen::Vector2d& x_n, const
   }
   out.d_epi = std::abs(EpipolarDistance(m.E, x_r, x_n));
   // Static point at depth z' (after rotation): x_n = p' + (t_xy - t_z p') / (z' + t_z).
-  const DepthFlow df = DepthFlowOf(m.R, m.t, x_r, x_n);
+  const DepthFlow df = DepthFlowAt(p, m.t, x_n);
   if (!df.valid) {  // the point sits on the epipole: no flow information
     out.p_fvb = 1.0;
     return out;
