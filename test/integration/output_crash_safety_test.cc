@@ -201,7 +201,9 @@ struct KillLoopResult {
   std::string first_error;
 };
 
-// Forks a writer `rounds` times and kills it at a random moment of its save loop.
+// Forks a writer `rounds` times and kills it: in even rounds at a random moment of
+// its save loop, in odd rounds (atomic saves) as soon as one of its saves has a
+// temporary file.
 KillLoopResult KillLoop(const std::string& dir, const Version* versions, bool atomic, int rounds, uint32_t seed) {
   std::vector<std::pair<std::string, std::string>> plain[2];
   if (!atomic) {
@@ -233,7 +235,16 @@ KillLoopResult KillLoop(const std::string& dir, const Version* versions, bool at
         }
       }
     }
-    std::this_thread::sleep_for(std::chrono::microseconds(delay_us(rng)));
+    if (!atomic || round % 2 == 0) {
+      // At a random moment of the loop: mostly between saves, as a save's temporary
+      // file exists for a small share of it.
+      std::this_thread::sleep_for(std::chrono::microseconds(delay_us(rng)));
+    } else {
+      // Aimed: as soon as the writer has a temporary file open (or after 2 s).
+      const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+      while (CountTempFiles(out, child) == 0 && std::chrono::steady_clock::now() < give_up) {
+      }
+    }
     kill(child, SIGKILL);
     int status = 0;
     waitpid(child, &status, 0);
