@@ -1,55 +1,76 @@
 #!/usr/bin/env bash
 # Real sequences for the camera trajectory (issue SLAM item 5): TartanAir indoor (189 continuous low-texture frames) and TUM fr3 cabinet (58 wide-baseline frames); live tracked fraction, trajectory-file fraction (with back-filled poses), ATE
 #
-#   scripts/eval.sh realdata-slam [--sequences "tartanair tum-cabinet"]
+#   scripts/eval.sh realdata-slam [--sequences "tartanair tum-cabinet"] [--starts "0 8 16 24 40"]
 #   (env SERVICE_ARGS="--set a.b=v ..." passes options to the service)
 #
 # camera_driver turns the dataset folder (../shared/data, or MBSLAM_DATA) into an LCM log
 # with its calibration and ground truth, the service replays it in lockstep, mbslam-eval
 # scores the trajectory file against the truth (Sim(3) alignment: monocular).
+# --starts (TartanAir only): the sequence is also replayed from these start images (its
+# images and truth shifted), because one lost track changes every later decision of
+# this sequence: a change is judged on the mean over starts, not on one replay.
 # JSON (last line): {"tartanair": {"frames", "tracked_fraction" (live poses / images),
 #   "posed_fraction" (trajectory file / images), "ate_rmse_m", "ate_rel_path",
-#   "path_length_m"}, "tum-cabinet": {...}}
+#   "path_length_m" (all of the first start); with several starts also "starts" (the same
+#   keys per start) and "tracked_fraction_mean", "posed_fraction_mean",
+#   "ate_rel_path_mean", "ate_rel_path_median"}, "tum-cabinet": {...}}
 set -euo pipefail
 source "$(dirname "$0")/_lib.sh"
 sequences="tartanair tum-cabinet"
+starts="0"
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --sequences) sequences="$2"; shift 2 ;;
+    --starts) starts="$2"; shift 2 ;;
     *) echo "realdata-slam: unknown argument $1" >&2; echo '{}'; exit 2 ;;
   esac
 done
+for k in $starts; do
+  if ! [[ "$k" =~ ^[0-9]+$ ]]; then echo "realdata-slam: --starts takes image indices, not '$k'" >&2; echo '{}'; exit 2; fi
+done
 out="$MBSLAM_EVAL_OUT"
 mkdir -p "$out"
-results=()
-for name in $sequences; do
+
+# tartanair_from START SRC DST: DST holds SRC's images from START on, renumbered from 0
+# (symbolic links), and its truth from the same line.
+tartanair_from() {
+  local k="$1" src="$2" dst="$3"
+  rm -rf "$dst"
+  mkdir -p "$dst/images"
+  local n i
+  n=$(find "$src/images" -name '*_left.jpg' | wc -l)
+  for ((i = k; i < n; i++)); do
+    ln -s "$src/images/$(printf %06d_left.jpg "$i")" "$dst/images/$(printf %06d_left.jpg $((i - k)))"
+  done
+  tail -n +$((k + 1)) "$src/pose_left.txt" > "$dst/pose_left.txt"
+}
+
+# run_one NAME DATA DIR -> prints the JSON object of one replay
+run_one() {
+  local name="$1" data="$2" dir="$3" source_kind calib rate truth c1 c2 c3
   case "$name" in
     tartanair)
-      data="$MBSLAM_DATA/tartanair_indoor_subset"; source_kind=tartanair; calib=config/camera/tartanair.yaml; rate=10
+      source_kind=tartanair; calib=config/camera/tartanair.yaml; rate=10
       truth="$data/pose_left.txt"; c1=1; c2=2; c3=3 ;;
     tum-cabinet)
-      data="$MBSLAM_DATA/tum_fr3_cabinet_subset"; source_kind=tum; calib=config/camera/tum_fr3.yaml; rate=0
+      source_kind=tum; calib=config/camera/tum_fr3.yaml; rate=0
       truth="$data/truth_cam_poses.txt"; c1=2; c2=3; c3=4 ;;
-    *) echo "realdata-slam: unknown sequence $name" >&2; continue ;;
   esac
-  if [[ ! -d "$data" ]]; then
-    echo "realdata-slam: $data missing, $name skipped" >&2
-    continue
-  fi
-  dir="$out/$name"
   mkdir -p "$dir"
-  log="$dir/camera.lcmlog"
-  rate_args=()
+  local log="$dir/camera.lcmlog"
+  local rate_args=()
   if [[ "$rate" != 0 ]]; then rate_args=(--rate "$rate"); fi
   "$MBSLAM_BIN/camera_driver" --source "$source_kind" --input "$data" "${rate_args[@]}" \
     --calibration "$MBSLAM_ROOT/$calib" --log "$log" --quiet --no-progress --log-level warning >&2
   run_service "$log" "$dir/run" ${SERVICE_ARGS:-}
+  local ate length
   ate=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$dir/run/result/camera_trajectory.tum" --gt-log "$log" \
         --plot "$dir/trajectory.png")
   length=$(awk -v a="$c1" -v b="$c2" -v c="$c3" '!/^#/ && NF >= 7 {
              if (n++) {dx = $a - x; dy = $b - y; dz = $c - z; L += sqrt(dx*dx + dy*dy + dz*dz)}
              x = $a; y = $b; z = $c} END {printf "%.6f\n", L}' "$truth")
-  results+=("$(python3 - "$name" "$dir/run/result/summary.json" "$length" "$ate" <<'PY'
+  python3 - "$name" "$dir/run/result/summary.json" "$length" "$ate" <<'PY'
 import json, sys
 name, summary_path, length, ate = sys.argv[1], sys.argv[2], float(sys.argv[3]), json.loads(sys.argv[4] or "{}")
 s = json.load(open(summary_path))
@@ -63,7 +84,52 @@ print(f"{name}: {s['frames']} images, live poses {100 * r['tracked_fraction']:.1
       f"{100 * r['posed_fraction']:.1f} %, ATE {rmse} m = "
       f"{'n/a' if r['ate_rel_path'] is None else round(100 * r['ate_rel_path'], 2)} % of the {length:.2f} m path",
       file=sys.stderr)
-print(json.dumps({name: r}))
+print(json.dumps(r))
+PY
+}
+
+results=()
+for name in $sequences; do
+  case "$name" in
+    tartanair) data="$MBSLAM_DATA/tartanair_indoor_subset" ;;
+    tum-cabinet) data="$MBSLAM_DATA/tum_fr3_cabinet_subset" ;;
+    *) echo "realdata-slam: unknown sequence $name" >&2; continue ;;
+  esac
+  if [[ ! -d "$data" ]]; then
+    echo "realdata-slam: $data missing, $name skipped" >&2
+    continue
+  fi
+  if [[ "$name" != tartanair || "$starts" == "0" ]]; then
+    results+=("{\"$name\": $(run_one "$name" "$data" "$out/$name")}")
+    continue
+  fi
+  per_start=()
+  for k in $starts; do
+    if [[ "$k" == 0 ]]; then
+      dir="$out/$name"; shifted="$data"
+    else
+      dir="$out/$name-from$k"; shifted="$out/data-$name-from$k"
+      tartanair_from "$k" "$data" "$shifted"
+    fi
+    echo "realdata-slam: $name from image $k" >&2
+    per_start+=("$k" "$(run_one "$name" "$shifted" "$dir")")
+  done
+  results+=("$(python3 - "$name" "${per_start[@]}" <<'PY'
+import json, statistics, sys
+name, rest = sys.argv[1], sys.argv[2:]
+runs = {int(rest[i]): json.loads(rest[i + 1]) for i in range(0, len(rest), 2)}
+first = runs[min(runs)] if 0 not in runs else runs[0]
+out = dict(first)
+out["starts"] = {str(k): v for k, v in runs.items()}
+for key in ("tracked_fraction", "posed_fraction", "ate_rel_path"):
+    vals = [v[key] for v in runs.values() if v.get(key) is not None]
+    out[key + "_mean"] = statistics.mean(vals) if vals else None
+vals = [v["ate_rel_path"] for v in runs.values() if v.get("ate_rel_path") is not None]
+out["ate_rel_path_median"] = statistics.median(vals) if vals else None
+print(f"{name} over starts {sorted(runs)}: live poses {100 * out['tracked_fraction_mean']:.1f} %, trajectory file "
+      f"{100 * out['posed_fraction_mean']:.1f} %, ATE mean {100 * out['ate_rel_path_mean']:.2f} % "
+      f"(median {100 * out['ate_rel_path_median']:.2f} %) of the path", file=sys.stderr)
+print(json.dumps({name: out}))
 PY
 )")
 done

@@ -548,6 +548,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   {
     ScopedStageTimer timer(slam_timer_);
     slam_pose = slam_.TrackPose(slam_frame);
+    if (slam_pose.epipolar_assisted) counters_->Increment(counter::kPoseEpipolarAssisted);
     // Re-found map points become tracks again (they rejoin the segmentation as static).
     for (const auto& [point_id, uv] : slam_pose.refound) {
       const int64_t track_id = tracker_.AdoptTrack(uv, 0);

@@ -1,10 +1,12 @@
 #include "services/perception/slam/pose_estimator.h"
 
 #include <cmath>
+#include <limits>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
+#include "services/perception/segmentation/relative_motion.h"
 #include "services/perception/slam/triangulation.h"
 
 namespace mbslam {
@@ -133,6 +135,217 @@ PoseEstimate EstimatePose(const std::vector<Eigen::Vector3d>& X, const std::vect
   Eigen::FullPivLU<Matrix6d> lu(info);
   out.covariance = lu.isInvertible() ? Matrix6d(sigma * sigma * lu.inverse()) : Matrix6d(Matrix6d::Identity());
   out.ok = inliers >= 6;
+  return out;
+}
+
+namespace {
+
+// One Gauss-Newton refinement of EstimatePoseWithEpipolar's cost: Huber-weighted
+// reprojection errors (use3) and epipolar distances (use2), all in normalised units, and
+// the prior (|t| - length)^2 on the length of the motion since the length reference,
+// weighted as a residual of standard deviation length_sigma against measurements of
+// sigma0.
+struct HybridProblem {
+  const std::vector<Eigen::Vector3d>* X;
+  const std::vector<Eigen::Vector2d>* xy;
+  const EpipolarLinks* links;
+  double huber = 0.0;
+  int length_reference = 0;
+  double length = 0.0;
+  double length_weight = 0.0;  // (sigma0 / length_sigma)^2
+
+  static double HuberCost(double e, double h) { return e <= h ? 0.5 * e * e : h * (e - 0.5 * h); }
+
+  // Per reference: the motion since it, its rotation and essential matrix.
+  struct Relative {
+    Rigid3d rel;
+    Eigen::Matrix3d R, E;
+  };
+  std::vector<Relative> Relatives(const Rigid3d& T) const {
+    std::vector<Relative> out;
+    for (const Rigid3d& ref : links->references) {
+      Relative r;
+      r.rel = T * ref.Inverse();
+      r.R = r.rel.RotationMatrix();
+      r.E = Hat(r.rel.translation) * r.R;
+      out.push_back(r);
+    }
+    return out;
+  }
+
+  // Refines T; returns the robust cost at the result, and the information matrix.
+  Rigid3d Refine(Rigid3d T, const std::vector<uint8_t>& use3, const std::vector<uint8_t>& use2, int iterations,
+                 Matrix6d* information, double* cost) const {
+    Matrix6d H = Matrix6d::Zero();
+    for (int iter = 0; iter <= iterations; ++iter) {
+      H.setZero();
+      Vector6d g = Vector6d::Zero();
+      double c = 0.0;
+      int n = 0;
+      for (size_t i = 0; i < X->size(); ++i) {
+        if (!use3[i]) continue;
+        Eigen::Vector2d proj;
+        Eigen::Matrix<double, 2, 6> J;
+        if (!ProjectionJacobians(T, (*X)[i], &proj, &J, nullptr)) continue;
+        const Eigen::Vector2d r = proj - (*xy)[i];
+        const double e = r.norm();
+        const double w = e <= huber ? 1.0 : huber / e;
+        H += w * J.transpose() * J;
+        g += w * J.transpose() * r;
+        c += HuberCost(e, huber);
+        ++n;
+      }
+      // A left perturbation of T is the same left perturbation of T * ref^-1.
+      const std::vector<Relative> rels = Relatives(T);
+      for (size_t i = 0; i < links->xy_ref.size(); ++i) {
+        if (!use2[i]) continue;
+        const Relative& r = rels[static_cast<size_t>(links->reference[i])];
+        Eigen::Matrix<double, 1, 6> J;
+        const double d = EpipolarDistanceAndJacobian(r.R, r.E, links->xy_ref[i], links->xy_cur[i], &J);
+        const double e = std::abs(d);
+        const double w = e <= huber ? 1.0 : huber / e;
+        H += w * J.transpose() * J;
+        g += w * J.transpose() * d;
+        c += HuberCost(e, huber);
+        ++n;
+      }
+      // Under Exp([v; w]) the motion's translation t moves by v + w x t, its length by u . v.
+      const Eigen::Vector3d& t = rels[static_cast<size_t>(length_reference)].rel.translation;
+      const double len = t.norm();
+      if (len > 1e-12 && length_weight > 0.0) {
+        const Eigen::Vector3d u = t / len;
+        const double r = len - length;
+        H.topLeftCorner<3, 3>() += length_weight * u * u.transpose();
+        g.head<3>() += length_weight * u * r;
+        c += 0.5 * length_weight * r * r;
+      }
+      if (cost) *cost = c;
+      if (iter == iterations || n < 6) break;
+      const Vector6d delta = H.ldlt().solve(-g);
+      if (!delta.allFinite()) break;
+      T = Rigid3d::Exp(delta) * T;
+      if (delta.norm() < 1e-10) iterations = iter + 1;  // one more pass: the cost and information at the result
+    }
+    if (information) *information = H;
+    return T;
+  }
+};
+
+}  // namespace
+
+HybridPoseEstimate EstimatePoseWithEpipolar(const std::vector<Eigen::Vector3d>& X,
+                                            const std::vector<Eigen::Vector2d>& xy, const EpipolarLinks& links,
+                                            const Rigid3d& prior, int start_reference, int length_reference,
+                                            double expected_length, double length_sigma_ratio, double focal,
+                                            const PoseEstimatorOptions& o) {
+  HybridPoseEstimate out;
+  const size_t n3 = X.size(), n2 = links.xy_ref.size();
+  const int num_refs = static_cast<int>(links.references.size());
+  if (xy.size() != n3 || links.xy_cur.size() != n2 || links.reference.size() != n2 || n2 < 8 ||
+      start_reference < 0 || start_reference >= num_refs || length_reference < 0 || length_reference >= num_refs) {
+    return out;
+  }
+  for (int r : links.reference) {
+    if (r < 0 || r >= num_refs) return out;
+  }
+  const double sigma0 = o.sigma_px / focal;
+  const double length = std::max(0.0, expected_length);
+  HybridProblem problem;
+  problem.X = &X;
+  problem.xy = &xy;
+  problem.links = &links;
+  problem.huber = o.huber_px / focal;
+  problem.length_reference = length_reference;
+  problem.length = length;
+  const double length_sigma = length_sigma_ratio * length;
+  problem.length_weight = length_sigma > 1e-12 ? (sigma0 * sigma0) / (length_sigma * length_sigma) : 0.0;
+
+  // Starts: the prediction, unless it (nearly) stands still where a motion is expected
+  // (the epipolar distances vanish with the translation), and the essential matrix of the
+  // start reference's links with the expected length carried over to that reference.
+  std::vector<Rigid3d> starts;
+  if ((prior * links.references[static_cast<size_t>(length_reference)].Inverse()).translation.norm() >=
+      0.1 * length) {
+    starts.push_back(prior);
+  }
+  {
+    std::vector<Eigen::Vector2d> a, b;
+    for (size_t i = 0; i < n2; ++i) {
+      if (links.reference[i] != start_reference) continue;
+      a.push_back(links.xy_ref[i]);
+      b.push_back(links.xy_cur[i]);
+    }
+    RelativeMotion motion;
+    std::vector<uint8_t> inl;
+    TwoViewOptions two_view;
+    two_view.ransac_threshold_px = o.ransac_threshold_px;
+    const Rigid3d& Ts = links.references[static_cast<size_t>(start_reference)];
+    if (a.size() >= 8 && EstimateRelativeMotion(a, b, focal, two_view, &motion, &inl).ok()) {
+      const Rigid3d predicted_rel = prior * Ts.Inverse();
+      Eigen::Vector3d t = predicted_rel.translation;
+      if (motion.translation_known) {
+        // The length since the start reference, from the expected one since the length
+        // reference and the prediction's ratio of the two.
+        const double predicted_len = (prior * links.references[static_cast<size_t>(length_reference)].Inverse()).translation.norm();
+        const double ratio = predicted_len > 1e-12 ? predicted_rel.translation.norm() / predicted_len : 1.0;
+        t = motion.cam_n_from_cam_r.translation.normalized() * length * ratio;
+      }
+      starts.push_back(Rigid3d(motion.cam_n_from_cam_r.rotation, t) * Ts);
+    }
+  }
+  if (starts.empty()) return out;
+  const std::vector<uint8_t> all3(n3, 1), all2(n2, 1);
+  Rigid3d T = prior;
+  double best = std::numeric_limits<double>::infinity();
+  for (const Rigid3d& start : starts) {
+    double cost = 0.0;
+    const Rigid3d refined = problem.Refine(start, all3, all2, o.refine_iterations, nullptr, &cost);
+    if (refined.IsFinite() && cost < best) {
+      best = cost;
+      T = refined;
+    }
+  }
+  // Inliers, and the refinement on them (twice, as EstimatePose).
+  const double inlier = o.inlier_px / focal;
+  std::vector<uint8_t> m3(n3, 0), m2(n2, 0);
+  std::vector<double> link_distance(n2, 0.0);
+  auto classify = [&](const Rigid3d& pose) {
+    const std::vector<HybridProblem::Relative> rels = problem.Relatives(pose);
+    for (size_t i = 0; i < n3; ++i) m3[i] = ReprojectionError(pose, X[i], xy[i]) <= inlier;
+    for (size_t i = 0; i < n2; ++i) {
+      const auto& r = rels[static_cast<size_t>(links.reference[i])];
+      link_distance[i] = std::abs(EpipolarDistance(r.E, links.xy_ref[i], links.xy_cur[i]));
+      m2[i] = link_distance[i] <= inlier;
+    }
+  };
+  Matrix6d info = Matrix6d::Zero();
+  classify(T);
+  for (int round = 0; round < 2; ++round) {
+    T = problem.Refine(T, m3, m2, o.refine_iterations, &info, nullptr);
+    classify(T);
+  }
+  PoseEstimate& pose = out.pose;
+  pose.cam_from_world = T;
+  pose.inliers = m3;
+  double sq = 0.0;
+  for (size_t i = 0; i < n3; ++i) {
+    if (!m3[i]) continue;
+    ++pose.num_inliers;
+    const double e = ReprojectionError(T, X[i], xy[i]) * focal;
+    sq += e * e;
+  }
+  pose.rms_px = pose.num_inliers ? std::sqrt(sq / pose.num_inliers) : 0.0;
+  sq = 0.0;
+  for (size_t i = 0; i < n2; ++i) {
+    if (!m2[i]) continue;
+    ++out.num_link_inliers;
+    sq += link_distance[i] * link_distance[i] * focal * focal;
+  }
+  out.link_inliers = m2;
+  out.link_rms_px = out.num_link_inliers ? std::sqrt(sq / out.num_link_inliers) : 0.0;
+  Eigen::FullPivLU<Matrix6d> lu(info);
+  pose.covariance = lu.isInvertible() ? Matrix6d(sigma0 * sigma0 * lu.inverse()) : Matrix6d(Matrix6d::Identity());
+  pose.ok = T.IsFinite() && out.num_link_inliers >= 8 && lu.isInvertible();
   return out;
 }
 

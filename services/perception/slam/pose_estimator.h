@@ -82,6 +82,39 @@ Rigid3d RefinePose(const Rigid3d& initial, const std::vector<Eigen::Vector3d>& p
                    double focal_px, double huber_px, int iterations, Matrix6d* information,
                    const PoseRotationPrior* rotation_prior = nullptr, double sigma_px = 1.0);
 
+// Resection helped by the epipolar geometry, for images whose map correspondences
+// are too few (a low-texture wall, tracks that live a few images): the 2D-2D
+// correspondences of static tracks with a posed reference image fix the rotation and
+// the direction of the motion, the 2D-3D ones (however few) its length, and a weak prior
+// on the length of the motion since the reference (the predicted one) holds it when no
+// map point is seen. Start: the prediction, and the reference-to-current essential
+// matrix (5-point RANSAC) with the predicted length; the one that explains more is refined
+// (Huber-weighted Gauss-Newton on a left perturbation, reprojection and epipolar
+// distances in normalised units).
+struct EpipolarLinks {
+  std::vector<Rigid3d> references;       // poses (cam_from_world) of the reference images
+  std::vector<int> reference;            // per link: its reference image (index into references)
+  std::vector<Eigen::Vector2d> xy_ref;   // normalised coordinates in the reference image
+  std::vector<Eigen::Vector2d> xy_cur;   // ... and in the current image
+};
+
+struct HybridPoseEstimate {
+  PoseEstimate pose;                     // inliers / num_inliers / rms_px: the 2D-3D correspondences
+  std::vector<uint8_t> link_inliers;
+  int num_link_inliers = 0;
+  double link_rms_px = 0.0;              // RMS epipolar distance of the link inliers (px)
+};
+
+// `prior`: the predicted pose (a start); `expected_length`: the length of the motion
+// since references[length_reference] (map units); `length_sigma_ratio`: the prior's
+// standard deviation as a share of it. The essential-matrix start uses the links of
+// references[start_reference].
+HybridPoseEstimate EstimatePoseWithEpipolar(const std::vector<Eigen::Vector3d>& points_in_world,
+                                            const std::vector<Eigen::Vector2d>& xy, const EpipolarLinks& links,
+                                            const Rigid3d& prior, int start_reference, int length_reference,
+                                            double expected_length, double length_sigma_ratio, double focal_px,
+                                            const PoseEstimatorOptions& options);
+
 }  // namespace mbslam
 
 #endif  // MBSLAM_SERVICES_PERCEPTION_SLAM_POSE_ESTIMATOR_H_

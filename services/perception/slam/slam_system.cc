@@ -74,6 +74,8 @@ void SlamSystem::Reset() {
   metric_ = false;
   confirm_count_ = 0;
   unposed_.clear();
+  posed_xy_.clear();
+  hybrid_frames_ = 0;
 }
 
 void SlamSystem::RestartMap(std::optional<Bridge> bridge) {
@@ -228,10 +230,17 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   out.num_correspondences = static_cast<int>(X.size());
   PoseEstimate est;
   if (X.size() >= 6) est = EstimatePose(X, xy, frame.focal_px, prior, options_.pose, TrackingRotationPrior(frame));
-  const bool good = est.ok && est.num_inliers >= options_.min_tracking_inliers;
+  bool good = est.ok && est.num_inliers >= options_.min_tracking_inliers;
   MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": correspondences " << X.size() << " (re-found "
                     << refound_ids.size() << "), inliers " << est.num_inliers << ", rms " << est.rms_px
                     << " px, points " << map_.num_points() << ", keyframes " << map_.num_keyframes();
+  bool assisted = false;
+  if (!good && options_.hybrid_tracking && (state_ == SlamState::kTracking || state_ == SlamState::kLost) && prior &&
+      hybrid_frames_ < options_.hybrid_max_frames) {
+    assisted = TrackWithEpipolar(frame, X, xy, *prior, &est);
+    good = assisted;
+  }
+  hybrid_frames_ = assisted ? hybrid_frames_ + 1 : 0;
   if (good && state_ == SlamState::kConfirming) {
     const double ratio = static_cast<double>(est.num_inliers) / static_cast<double>(X.size());
     if (ratio < options_.init_confirm_inlier_ratio) {
@@ -258,7 +267,14 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     out.num_inliers = est.num_inliers;
     last_inliers_ = est.num_inliers;
     out.num_refound = 0;
+    out.epipolar_assisted = assisted;
     StorePose(frame.frame_index, est.cam_from_world, est.covariance);
+    if (options_.hybrid_tracking) {
+      auto& seen = posed_xy_[frame.frame_index];
+      seen.clear();
+      for (const SlamObservation& o : frame.observations) seen.emplace(o.track_id, o.xy);
+      while (static_cast<int>(posed_xy_.size()) > options_.hybrid_reference_frames) posed_xy_.erase(posed_xy_.begin());
+    }
     for (size_t i = 0; i < tracks.size(); ++i) {
       if (tracks[i] < 0) {  // re-found by guided matching
         const size_t k = static_cast<size_t>(-1 - tracks[i]);
@@ -312,6 +328,76 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   last_frame_ = frame.frame_index;
   if (!out.valid) RememberUnposed(frame);
   return out;
+}
+
+bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eigen::Vector3d>& X,
+                                   const std::vector<Eigen::Vector2d>& xy, const Rigid3d& prior, PoseEstimate* est) {
+  // Links: every track not held by a moving object (static ones, and those segmentation
+  // has not placed yet: new, or unexplained but in no object; a minority on movers is
+  // refused as outliers by the robust estimate), to the oldest recent posed image that
+  // saw it (the longest baseline).
+  EpipolarLinks links;
+  std::vector<int64_t> ref_frames;
+  std::vector<int> per_reference;
+  std::unordered_map<int64_t, int> linked;  // track -> reference index
+  for (const auto& [f, seen] : posed_xy_) {
+    if (f >= frame.frame_index) continue;
+    const std::optional<Rigid3d> T = PoseOf(f);
+    if (!T) continue;
+    const int r = static_cast<int>(ref_frames.size());
+    int count = 0;
+    for (const SlamObservation& o : frame.observations) {
+      if (o.body_id > 0 || linked.count(o.track_id)) continue;
+      auto it = seen.find(o.track_id);
+      if (it == seen.end()) continue;
+      linked.emplace(o.track_id, r);
+      links.reference.push_back(r);
+      links.xy_ref.push_back(it->second);
+      links.xy_cur.push_back(o.xy);
+      ++count;
+    }
+    ref_frames.push_back(f);
+    per_reference.push_back(count);
+    links.references.push_back(*T);
+  }
+  if (static_cast<int>(links.xy_ref.size()) < options_.hybrid_min_links) return false;
+  const int start_reference = static_cast<int>(
+      std::max_element(per_reference.begin(), per_reference.end()) - per_reference.begin());
+  const int length_reference = static_cast<int>(ref_frames.size()) - 1;
+  // The expected length: the speed of the camera over the recent map-based poses (held
+  // through a run of these poses, which would otherwise feed their own drift back).
+  if (hybrid_frames_ == 0) {
+    hybrid_speed_ = -1.0;
+    double path = 0.0;
+    int64_t first = -1, last = -1;
+    std::optional<Eigen::Vector3d> previous;
+    for (auto it = recent_poses_.rbegin(); it != recent_poses_.rend() && (first < 0 || last - first < 10); ++it) {
+      const std::optional<Rigid3d> T = PoseOf(it->first);
+      if (!T) continue;
+      const Eigen::Vector3d centre = T->Inverse().translation;
+      if (previous) path += (centre - *previous).norm();
+      previous = centre;
+      if (last < 0) last = it->first;
+      first = it->first;
+    }
+    if (last > first) hybrid_speed_ = path / static_cast<double>(last - first);
+  }
+  const Rigid3d& length_ref = links.references.back();
+  const double expected_length = hybrid_speed_ >= 0.0
+                                     ? hybrid_speed_ * static_cast<double>(frame.frame_index - ref_frames.back())
+                                     : (prior * length_ref.Inverse()).translation.norm();
+  const HybridPoseEstimate h =
+      EstimatePoseWithEpipolar(X, xy, links, prior, start_reference, length_reference, expected_length,
+                               options_.hybrid_length_sigma, frame.focal_px, options_.pose);
+  const bool ok = h.pose.ok && h.num_link_inliers >= options_.hybrid_min_links &&
+                  h.num_link_inliers >= options_.hybrid_min_link_ratio * static_cast<double>(links.xy_ref.size());
+  MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": epipolar-assisted pose, " << h.num_link_inliers
+                    << " of " << links.xy_ref.size() << " tracks linked to images " << ref_frames.front() << "-"
+                    << ref_frames.back() << " (rms " << h.link_rms_px << " px), " << h.pose.num_inliers << " of "
+                    << X.size() << " map points" << (ok ? "" : ": refused");
+  if (!ok) return false;
+  *est = h.pose;
+  return true;
 }
 
 void SlamSystem::RememberUnposed(const SlamFrame& frame) {
