@@ -54,6 +54,27 @@ int HammingDistance(const uint8_t* a, const uint8_t* b, int bytes) {
   return d;
 }
 
+// ORB's orientation of a point (the intensity centroid of the disc of radius 15 around
+// it, degrees in [0, 360)), for descriptors computed at given positions: cv::ORB::compute
+// takes a provided keypoint's angle as it is, and the keypoints it detects in the other
+// image are oriented. -1 when the disc leaves the image.
+float IntensityCentroidAngle(const cv::Mat& image, const cv::Point2f& pt) {
+  constexpr int kRadius = 15;
+  const int cx = static_cast<int>(std::lround(pt.x)), cy = static_cast<int>(std::lround(pt.y));
+  if (cx < kRadius || cy < kRadius || cx >= image.cols - kRadius || cy >= image.rows - kRadius) return -1.0f;
+  int64_t m01 = 0, m10 = 0;
+  for (int v = -kRadius; v <= kRadius; ++v) {
+    const int u_max = static_cast<int>(std::floor(std::sqrt(kRadius * kRadius - v * v + 0.5)));
+    const uint8_t* row = image.ptr<uint8_t>(cy + v);
+    for (int u = -u_max; u <= u_max; ++u) {
+      const int i = row[cx + u];
+      m10 += u * i;
+      m01 += v * i;
+    }
+  }
+  return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
+}
+
 // The brightness change of one image to the next, as the map that undoes it:
 // previous ~ gain * new + offset; mean_change is the new image's mean minus the previous
 // one's (grey levels).
@@ -592,7 +613,16 @@ void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat
   cv::Ptr<cv::ORB> orb = cv::ORB::create(options_.fallback_features);
   // Descriptors of the lost tracks at their previous positions.
   std::vector<cv::KeyPoint> prev_kps;
-  for (const Track& t : *lost) prev_kps.emplace_back(cv::Point2f(t.uv.x(), t.uv.y()), 31.0f);
+  for (const Track& t : *lost) {
+    const cv::Point2f pt(t.uv.x(), t.uv.y());
+    if (options_.fallback_orientation) {
+      const float angle = IntensityCentroidAngle(prev_image, pt);
+      if (angle < 0.0f) continue;  // ORB would drop it at the border anyway
+      prev_kps.emplace_back(pt, 31.0f, angle);
+    } else {
+      prev_kps.emplace_back(pt, 31.0f);
+    }
+  }
   cv::Mat prev_desc;
   orb->compute(prev_image, prev_kps, prev_desc);  // drops keypoints too close to the border
   if (prev_kps.empty()) return;

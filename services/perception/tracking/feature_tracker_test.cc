@@ -473,3 +473,48 @@ TEST(FeatureTracker, DriftedTracksAreRealignedOnTheirWarpedReference) {
 
 }  // namespace
 }  // namespace mbslam
+
+namespace mbslam {
+namespace {
+
+// A wide-baseline view turned by 25 deg: KLT loses most tracks and the ORB fallback
+// re-finds them. The lost tracks' descriptors must be oriented as the new image's
+// keypoints are (tracking.fallback_orientation): unoriented, few of them match.
+int RefoundWithinPx(bool oriented, double max_err_px, int* matched) {
+  TrackerOptions o;
+  o.fallback_orientation = oriented;
+  FeatureTracker tracker(o);
+  const cv::Mat base = testing_images::Texture(640, 480, 9);
+  tracker.TrackFrame(Pyramid(base), 0, {});
+  std::map<int64_t, Eigen::Vector2f> start;
+  for (const Track& t : tracker.tracks()) start[t.id] = t.uv;
+  const cv::Point2f centre(319.5f, 239.5f);
+  const cv::Mat rot = cv::getRotationMatrix2D(centre, 25.0, 1.0);
+  cv::Mat turned;
+  cv::warpAffine(base, turned, rot, base.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  tracker.TrackFrame(Pyramid(turned), 1, {});
+  *matched = tracker.stats().descriptor_matched;
+  int good = 0;
+  for (const Track& t : tracker.tracks()) {
+    auto it = start.find(t.id);
+    if (it == start.end() || t.last_seen_frame != 1) continue;
+    const Eigen::Vector2f p = it->second;
+    const Eigen::Vector2f expected(static_cast<float>(rot.at<double>(0, 0) * p.x() + rot.at<double>(0, 1) * p.y() + rot.at<double>(0, 2)),
+                                   static_cast<float>(rot.at<double>(1, 0) * p.x() + rot.at<double>(1, 1) * p.y() + rot.at<double>(1, 2)));
+    good += (t.uv - expected).norm() <= max_err_px;
+  }
+  return good;
+}
+
+TEST(FeatureTracker, DescriptorFallbackRefindsTracksAcrossATurn) {
+  int matched_plain = 0, matched_oriented = 0;
+  const int good_plain = RefoundWithinPx(false, 2.0, &matched_plain);
+  const int good_oriented = RefoundWithinPx(true, 2.0, &matched_oriented);
+  std::cout << "descriptor fallback under a 25 deg turn: unoriented " << matched_plain << " matched, oriented "
+            << matched_oriented << "; tracks within 2 px " << good_plain << " / " << good_oriented << "\n";
+  EXPECT_GT(matched_oriented, 5 * std::max(matched_plain, 10));
+  EXPECT_GT(good_oriented, good_plain + 50);
+}
+
+}  // namespace
+}  // namespace mbslam
