@@ -359,7 +359,7 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
   EpipolarLinks links;
   std::vector<int64_t> ref_frames;
   std::vector<int> per_reference;
-  std::unordered_map<int64_t, int> linked;  // track -> reference index
+  std::unordered_set<int64_t> linked;
   for (const auto& [f, seen] : posed_xy_) {
     if (f >= frame.frame_index) continue;
     const std::optional<Rigid3d> T = PoseOf(f);
@@ -370,7 +370,7 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
       if (o.body_id > 0 || linked.count(o.track_id)) continue;
       auto it = seen.find(o.track_id);
       if (it == seen.end()) continue;
-      linked.emplace(o.track_id, r);
+      linked.insert(o.track_id);
       links.reference.push_back(r);
       links.xy_ref.push_back(it->second);
       links.xy_cur.push_back(o.xy);
