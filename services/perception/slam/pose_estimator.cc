@@ -11,6 +11,35 @@
 
 namespace mbslam {
 
+namespace {
+
+double HuberCost(double e, double h) { return e <= h ? 0.5 * e * e : h * (e - 0.5 * h); }
+
+// Adds the Huber-weighted reprojection terms of the used correspondences (normalised
+// units) to the normal equations H, g of a left perturbation of T; returns how many
+// entered and adds their Huber cost to *cost when given.
+int AddReprojectionTerms(const Rigid3d& T, const std::vector<Eigen::Vector3d>& X,
+                         const std::vector<Eigen::Vector2d>& xy, const std::vector<uint8_t>& use, double huber,
+                         Matrix6d* H, Vector6d* g, double* cost) {
+  int n = 0;
+  for (size_t i = 0; i < X.size(); ++i) {
+    if (!use[i]) continue;
+    Eigen::Vector2d proj;
+    Eigen::Matrix<double, 2, 6> J;
+    if (!ProjectionJacobians(T, X[i], &proj, &J, nullptr)) continue;
+    const Eigen::Vector2d r = proj - xy[i];
+    const double e = r.norm();
+    const double w = e <= huber ? 1.0 : huber / e;
+    *H += w * J.transpose() * J;
+    *g += w * J.transpose() * r;
+    if (cost) *cost += HuberCost(e, huber);
+    ++n;
+  }
+  return n;
+}
+
+}  // namespace
+
 Rigid3d RefinePose(const Rigid3d& initial, const std::vector<Eigen::Vector3d>& X,
                    const std::vector<Eigen::Vector2d>& xy, const std::vector<uint8_t>& use,
                    double focal, double huber_px, int iterations, Matrix6d* information,
@@ -26,19 +55,7 @@ Rigid3d RefinePose(const Rigid3d& initial, const std::vector<Eigen::Vector3d>& X
   for (int iter = 0; iter < iterations; ++iter) {
     H.setZero();
     Vector6d g = Vector6d::Zero();
-    int n = 0;
-    for (size_t i = 0; i < X.size(); ++i) {
-      if (!use[i]) continue;
-      Eigen::Vector2d proj;
-      Eigen::Matrix<double, 2, 6> J;
-      if (!ProjectionJacobians(T, X[i], &proj, &J, nullptr)) continue;
-      const Eigen::Vector2d r = proj - xy[i];
-      const double e = r.norm();
-      const double w = e <= huber ? 1.0 : huber / e;
-      H += w * J.transpose() * J;
-      g += w * J.transpose() * r;
-      ++n;
-    }
+    const int n = AddReprojectionTerms(T, X, xy, use, huber, &H, &g, nullptr);
     if (n < 3) break;
     if (rotation_prior) {
       // r = Log(R target^T); under R' = Exp(w) R, dr/dw = J_l^-1(r).
@@ -154,8 +171,6 @@ struct HybridProblem {
   double length = 0.0;
   double length_weight = 0.0;  // (sigma0 / length_sigma)^2
 
-  static double HuberCost(double e, double h) { return e <= h ? 0.5 * e * e : h * (e - 0.5 * h); }
-
   // Per reference: the motion since it, its rotation and essential matrix.
   struct Relative {
     Rigid3d rel;
@@ -181,20 +196,7 @@ struct HybridProblem {
       H.setZero();
       Vector6d g = Vector6d::Zero();
       double c = 0.0;
-      int n = 0;
-      for (size_t i = 0; i < X->size(); ++i) {
-        if (!use3[i]) continue;
-        Eigen::Vector2d proj;
-        Eigen::Matrix<double, 2, 6> J;
-        if (!ProjectionJacobians(T, (*X)[i], &proj, &J, nullptr)) continue;
-        const Eigen::Vector2d r = proj - (*xy)[i];
-        const double e = r.norm();
-        const double w = e <= huber ? 1.0 : huber / e;
-        H += w * J.transpose() * J;
-        g += w * J.transpose() * r;
-        c += HuberCost(e, huber);
-        ++n;
-      }
+      int n = AddReprojectionTerms(T, *X, *xy, use3, huber, &H, &g, &c);
       // A left perturbation of T is the same left perturbation of T * ref^-1.
       const std::vector<Relative> rels = Relatives(T);
       for (size_t i = 0; i < links->xy_ref.size(); ++i) {
