@@ -1,6 +1,7 @@
 # eval_scenario NAME [FRAMES]: the whole pipeline on a simulated scenario, scored for
 # segmentation and camera trajectory; with ABLATION=1 also without segmentation
-# feedback into SLAM. Sourced by the sim-* evaluations.
+# feedback into SLAM; with FVB_ABLATION=1 also with the epipolar constraint alone (no
+# Flow Vector Bound), scored for segmentation. Sourced by the sim-* evaluations.
 source "$(dirname "${BASH_SOURCE[0]}")/_lib.sh"
 
 eval_scenario() {
@@ -12,7 +13,7 @@ eval_scenario() {
   local cam_height
   cam_height=$(awk '!/^#/ && NF >= 8 {s += $4; n++} END {if (n) printf "%.3f", s / n; else print 0}' "$seq/cam_trajectory.tum")
   run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/run" --set "objects.camera_height_m=$cam_height" ${SERVICE_ARGS:-}
-  local ate seg ate_nf="{}" occ="{}" obj="{}" obj05="{}" rec="{}"
+  local ate seg ate_nf="{}" seg_epi="{}" occ="{}" obj="{}" obj05="{}" rec="{}"
   ate=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/run/result/camera_trajectory.tum" \
         --gt-sequence "$seq" --plot "$MBSLAM_EVAL_OUT/trajectory.png")
   seg=$(last_json "$MBSLAM_BIN/mbslam-eval-segmentation" --run "$MBSLAM_EVAL_OUT/run/out.lcmlog" --sequence "$seq" --name "$name")
@@ -38,9 +39,16 @@ eval_scenario() {
     ate_nf=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/no_feedback/result/camera_trajectory.tum" \
              --gt-sequence "$seq")
   fi
+  if [[ "${FVB_ABLATION:-0}" == "1" ]]; then
+    # The same options, the Flow Vector Bound off: what the epipolar constraint alone finds.
+    run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/epipolar_only" --set "objects.camera_height_m=$cam_height" \
+      ${SERVICE_ARGS:-} --set segmentation.likelihood.use_fvb=false
+    seg_epi=$(last_json "$MBSLAM_BIN/mbslam-eval-segmentation" --run "$MBSLAM_EVAL_OUT/epipolar_only/out.lcmlog" \
+              --sequence "$seq" --name "$name-epipolar-only")
+  fi
   local len
   len=$(path_length "$seq/cam_trajectory.tum")
-  python3 - "$name" "$ate" "$seg" "$ate_nf" "$len" "$MBSLAM_EVAL_OUT/run/result/summary.json" "$occ" "$obj" "$obj05" "$cam_height" "$rec" <<'PY'
+  python3 - "$name" "$ate" "$seg" "$ate_nf" "$len" "$MBSLAM_EVAL_OUT/run/result/summary.json" "$occ" "$obj" "$obj05" "$cam_height" "$rec" "$seg_epi" <<'PY'
 import json, sys
 name, ate, seg, ate_nf, length = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3]), json.loads(sys.argv[4]), float(sys.argv[5])
 summary = json.load(open(sys.argv[6]))
@@ -49,6 +57,7 @@ obj = json.loads(sys.argv[8] or "{}")
 obj05 = json.loads(sys.argv[9] or "{}")
 objs = obj.get("objects", [])
 rec = json.loads(sys.argv[11] or "{}")
+seg_epi = json.loads(sys.argv[12] or "{}")
 scales = [o["relative_scale_error"] for o in objs if o.get("settled_samples", 0) > 0]
 rmse = ate.get("ate_rmse_m")
 out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float(sys.argv[10]),
@@ -86,6 +95,10 @@ out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float
        "object_reconstruction_images": rec.get("object_reconstruction_images"),
        "object_reconstruction_body": rec.get("object_reconstruction_body"),
        "timings_ms": {k: v.get("mean_ms") for k, v in summary.get("timings", {}).items()}}
+if seg_epi:
+    out["moving_recall_epipolar_only"] = seg_epi.get("moving_recall")
+    out["moving_precision_epipolar_only"] = seg_epi.get("moving_precision")
+    out["detection_delay_frames_epipolar_only"] = seg_epi.get("detection_delay_frames")
 if ate_nf:
     out["ate_rel_path_no_feedback"] = ate_nf["ate_rmse_m"] / length if ("ate_rmse_m" in ate_nf and length > 0) else None
     out["tracked_fraction_no_feedback"] = ate_nf.get("fraction_tracked")
@@ -112,6 +125,9 @@ if occ:
     print(f"  occupancy: precision {occ.get('occupancy_precision')}, recall {occ.get('occupancy_recall')} (voxel {occ.get('resolution_m')} m)")
 if ate_nf:
     print(f"  without segmentation feedback: ATE {pct(out.get('ate_rel_path_no_feedback'))}, tracked {pct(out.get('tracked_fraction_no_feedback'))}")
+if seg_epi:
+    print(f"  epipolar constraint alone (no FVB): moving recall {out['moving_recall_epipolar_only']}, "
+          f"precision {out['moving_precision_epipolar_only']}")
 print(json.dumps(out))
 PY
 }
