@@ -289,8 +289,8 @@ DepthBound PerceptionCore::DepthBoundFor(int64_t track_id, const Eigen::Vector2d
   if (elevation < min_elevation) return bound;
   const double z_ground = -ground_->Height(c) / nd;
   if (z_ground <= 0.0) return bound;
-  const double tilt = options_.ground.depth_bound_tilt_sigma_deg * M_PI / 180.0;
-  const double cap = z_ground * (1.0 + options_.ground.depth_bound_margin + tilt / std::tan(elevation));
+  const double cap = GroundDepthCap(z_ground, elevation, options_.ground.depth_bound_margin,
+                                    options_.ground.depth_bound_tilt_sigma_deg);
   bound.z_max = std::min(bound.z_max, cap);
   if (bound.z_min > bound.z_max) bound.z_min = 0.0;  // the map point itself is below ground: not trusted
   return bound;
@@ -616,7 +616,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     MBSLAM_LOG(DEBUG) << "frame " << frame_index_ << ": tracks " << seg.labels.size() << " moving "
                       << moving << " new " << unjudged << " objects " << seg.objects.size() << " world motion "
                       << (seg.world_motion ? (seg.world_motion->translation_known ? "R,t" : "R only") : "none")
-                      << " ref " << seg.world_ref_frame;
+                      << " ref " << seg.world_ref_frame << " pair ground " << seg.pair_ground_inliers;
   }
 
   // Labels back onto the tracks (feedback to the tracker's occlusion handling).

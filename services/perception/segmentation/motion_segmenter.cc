@@ -135,20 +135,39 @@ std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput&
   return motion;
 }
 
-void MotionSegmenter::UpdateStaticProbabilities(const SegmenterInput& in, int64_t ref,
-                                                const RelativeMotion& motion) {
+int MotionSegmenter::UpdateStaticProbabilities(const SegmenterInput& in, int64_t ref,
+                                               const RelativeMotion& motion) {
   const std::vector<MotionSample> samples = MotionSigmaPoints(motion);
   StaticLikelihoodOptions likelihood = options_.likelihood;
   if (likelihood.envelope_combine == "max_odometry") {
     likelihood.envelope_combine = motion.source == RelativeMotion::Source::kOdometry ? "max" : "mean";
   }
+  // The pair's ground plane, from the tracks believed static, in the motion's units.
+  std::optional<PairGroundPlane> ground;
+  if (options_.pair_ground.enabled && options_.likelihood.use_fvb && motion.translation_known &&
+      (options_.pair_ground.with_map || !motion.scale_known)) {
+    std::vector<Eigen::Vector2d> xr, xn;
+    for (const TrackObservation& o : in.observations) {
+      const TrackState& t = tracks_.at(o.id);
+      Eigen::Vector2d x;
+      if (t.moving || t.p_static < options_.world_min_p_static || !t.At(ref, &x)) continue;
+      xr.push_back(x);
+      xn.push_back(o.xy);
+    }
+    ground = FitPairGroundPlane(xr, xn, motion.cam_n_from_cam_r.RotationMatrix(), motion.cam_n_from_cam_r.translation,
+                                in.focal_px, options_.likelihood.sigma_px, options_.pair_ground);
+  }
+  // With a plane the translation's units are those of the bounds; the caller's bounds
+  // are in them only if the motion said so.
+  const bool scale_known = motion.scale_known || ground.has_value();
   for (const TrackObservation& o : in.observations) {
     TrackState& t = tracks_.at(o.id);
     Eigen::Vector2d x_r;
     if (!t.At(ref, &x_r)) continue;
-    const DepthBound depth = in.depth_bound ? in.depth_bound(o.id, x_r, ref) : DepthBound();
+    DepthBound depth = in.depth_bound && motion.scale_known ? in.depth_bound(o.id, x_r, ref) : DepthBound();
+    if (ground) depth = CapDepthByGround(*ground, x_r, depth, options_.pair_ground);
     const StaticLikelihood lik =
-        ComputeStaticLikelihood(x_r, o.xy, samples, motion.translation_known, motion.scale_known,
+        ComputeStaticLikelihood(x_r, o.xy, samples, motion.translation_known, scale_known,
                                 depth, in.focal_px, likelihood);
     t.p_static = BayesUpdate(t.p_static, lik.p_static, lik.parallax_px);
     t.epipolar_px = lik.epipolar_px;
@@ -156,6 +175,7 @@ void MotionSegmenter::UpdateStaticProbabilities(const SegmenterInput& in, int64_
     if (t.moving && t.p_static >= options_.static_enter) t.moving = false;
     else if (!t.moving && t.p_static < options_.static_leave) t.moving = true;
   }
+  return ground ? ground->inliers : 0;
 }
 
 void MotionSegmenter::UpdateObjectModels(const SegmenterInput& in, int64_t ref) {
@@ -536,7 +556,7 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
     }
     if (motion) {
       initialized_ = true;
-      UpdateStaticProbabilities(in, ref, *motion);
+      result.pair_ground_inliers = UpdateStaticProbabilities(in, ref, *motion);
       result.world_motion = motion;
       result.world_ref_frame = ref;
       if (motion->translation_known) {

@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 
 #include "common/config/options.h"
+#include "services/perception/segmentation/ground_bound.h"
 #include "services/perception/segmentation/relative_motion.h"
 #include "services/perception/segmentation/static_likelihood.h"
 #include "services/perception/segmentation/subspace_clustering.h"
@@ -32,6 +33,10 @@ namespace mbslam {
 struct SegmentationOptions {
   StaticLikelihoodOptions likelihood;
   TwoViewOptions two_view;
+  // The ground plane of each image pair (the static tracks' inverse depths under the
+  // world motion): rays that meet it get a depth bound for the Flow Vector Bound, also
+  // before a map exists.
+  PairGroundOptions pair_ground;
   int object_model_max_iterations = 50;   // RANSAC iterations of each moving object's two-view model (count; per image and object)
   SubspaceClusteringOptions multibody;  // multi-view multibody initialisation (sec. 3.4)
   bool multibody_init = false;      // (re)initialise bodies by affine subspace clustering of the track window (near-affine views, e.g. Hopkins; not for forward motion)
@@ -82,6 +87,7 @@ struct SegmentationOptions {
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(likelihood);
     MBSLAM_CHECK_OPTION_SECTION(two_view);
+    MBSLAM_CHECK_OPTION_SECTION(pair_ground);
     MBSLAM_CHECK_OPTION_GE(object_model_max_iterations, 1);
     MBSLAM_CHECK_OPTION_SECTION(multibody);
     MBSLAM_CHECK_OPTION_GE(multibody_min_frames, 2);
@@ -111,6 +117,7 @@ struct SegmentationOptions {
   void VisitFields(V& v) {
     v("likelihood", &likelihood, "epipolar + Flow Vector Bound likelihood");
     v("two_view", &two_view, "robust two-view motion estimate");
+    v("pair_ground", &pair_ground, "ground plane of each image pair: depth bound of the rays that meet it");
     v("object_model_max_iterations", &object_model_max_iterations,
       "RANSAC iterations of each moving object's model per image (count)");
     v("multibody", &multibody, "multi-view multibody initialisation (subspace clustering)");
@@ -197,6 +204,7 @@ struct SegmentationResult {
   std::vector<SegmentedObject> objects;
   std::optional<RelativeMotion> world_motion;  // used for this image (ref -> current)
   int64_t world_ref_frame = -1;
+  int pair_ground_inliers = 0;       // tracks on the pair's ground plane (0: none found / used)
   Eigen::Vector3d epipole = Eigen::Vector3d::Zero();  // homogeneous, px
   bool initialized = false;          // the static world has been identified
 };
@@ -239,7 +247,8 @@ class MotionSegmenter {
 
   void UpdateHistories(const SegmenterInput& input);
   std::optional<RelativeMotion> WorldMotion(const SegmenterInput& input, int64_t ref);
-  void UpdateStaticProbabilities(const SegmenterInput& input, int64_t ref, const RelativeMotion& motion);
+  // Returns the tracks on the pair's ground plane (0 if none was found or used).
+  int UpdateStaticProbabilities(const SegmenterInput& input, int64_t ref, const RelativeMotion& motion);
   void UpdateObjectModels(const SegmenterInput& input, int64_t ref);
   void ClusterUnexplained(const SegmenterInput& input, int64_t ref);
   // `parallax_px`: how much the pair could tell; static evidence from pairs with little
