@@ -39,7 +39,8 @@ keys = ["ate_rel_path", "tracked_fraction", "scale_error", "moving_recall", "mov
         "predicted_hit_rate_0_5s_all_estimates", "predicted_hit_rate_1s_all_estimates",
         "predicted_overlap_rate_1s_all_estimates",
         "object_samples_matched_share", "object_samples_phantom_share", "occupancy_precision",
-        "occupancy_recall", "object_traj_err_rel", "object_shape_err_rel", "track_misclassification"]
+        "occupancy_recall", "object_traj_err_rel", "object_shape_err_rel", "track_misclassification",
+        "ate_rel_path_no_feedback", "feedback_ablation_ratio", "moving_recall_epipolar_only"]
 args = sys.argv[1:]
 runs = {}
 for i in range(0, len(args), 3):
@@ -48,6 +49,10 @@ for i in range(0, len(args), 3):
         d = json.load(open(path))
     except Exception:
         d = {}
+    # The segmentation-feedback ablation (sim-multi): the ATE without it over the ATE with it.
+    nf, ate = d.get("ate_rel_path_no_feedback"), d.get("ate_rel_path")
+    if isinstance(nf, (int, float)) and isinstance(ate, (int, float)) and ate > 0:
+        d["feedback_ablation_ratio"] = nf / ate
     runs.setdefault(name, []).append((seed, d))
 out = {}
 for name, rs in runs.items():
