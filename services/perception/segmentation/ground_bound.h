@@ -2,23 +2,24 @@
 #define MBSLAM_SERVICES_PERCEPTION_SEGMENTATION_GROUND_BOUND_H_
 
 // The ground plane of one image pair, for the Flow Vector Bound's depth bound before a
-// map exists (thesis sec. 3.5.2 with the ground plane cue of sec. 5.1.1).
+// map has one (thesis sec. 3.5.2 with the ground plane cue of sec. 5.1.1).
 //
 // For a plane n.X = d seen from the reference camera, a point's inverse depth is linear
 // in its normalised image position: 1 / z = m . [x y 1] with m = n / d. Under the pair's
 // motion (R, t), each static track's inverse depth s follows from its two positions
 // (x_n ~ R [x_r; 1] + t s), in the units of t, whatever they are (a two-view estimate's
 // unit translation, the map's units): so the plane m comes out in the units of the
-// motion, and so does every depth bound taken from it. The plane is the largest set of
-// tracks whose inverse depths lie on one such plane below the camera, its normal within
-// max_tilt_deg of the reference camera's down axis (+y: the image's "down" is the
-// world's, as for the ground plane of the map), its tracks spanning a range of depths
-// (near the horizon any steep plane fits a distant facade's tracks), with few tracks
-// beyond it (the static world stands on the ground; a slab through a cloud of points
-// has half of them beyond). A static point lies on or above the
-// ground, so along a ray that meets the ground in front of the camera its depth is at
-// most where the ray meets it: a track moving with the camera (a degenerate mover) looks
-// farther away than that, and the flow bound catches it.
+// motion, and so does every depth bound taken from it. The plane is fitted by MSAC (with
+// a local refit) to the tracks whose inverse depth is precise, and must qualify: below
+// the camera, its normal within max_tilt_deg of the reference camera's down axis (+y:
+// the image's "down" is the world's, as for the ground plane of the map); its inliers
+// spanning a range of depths (near the horizon any steep plane fits a distant facade's
+// tracks); few tracks beyond it, imprecise ones included (the static world stands on the
+// ground; a slab through a cloud of points, or a wrong plane under far tracks, has many
+// beyond). A static point lies on or above the ground, so along a ray that meets the
+// ground in front of the camera its depth is at most where the ray meets it: a track
+// moving with the camera (a degenerate mover) looks farther away than that, and the flow
+// bound catches it.
 
 #include <cmath>
 #include <optional>
