@@ -177,7 +177,8 @@ std::optional<PairGroundPlane> FitPairGroundPlane(const std::vector<Eigen::Vecto
       if (miss <= 0.0) {
         iterations = it + 1;
       } else if (miss < 1.0) {
-        iterations = std::min(iterations, it + 1 + static_cast<int>(std::ceil(std::log(0.01) / std::log(miss))));
+        const double needed_more = std::ceil(std::log(0.01) / std::log(miss));
+        iterations = std::min(iterations, it + 1 + static_cast<int>(std::min<double>(needed_more, iterations)));
       }
     }
   }

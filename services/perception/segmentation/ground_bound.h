@@ -37,7 +37,7 @@ struct PairGroundOptions {
   bool with_map = false;           // also when the world motion comes with a map's scale and depth bounds (the map has its own ground plane)
   double max_tilt_deg = 30.0;      // normal at most this far from the reference camera's down axis (deg)
   int min_inliers = 20;            // fewer tracks on the plane: no plane (count)
-  double min_inlier_share = 0.15;  // of the tracks whose inverse depth is measured [0, 1]
+  double min_inlier_share = 0.15;  // of the tracks whose inverse depth is precise enough to fit [0, 1]
   double inlier_sigmas = 3.0;      // inverse-depth residual of an inlier, in its own standard deviations
   double inlier_rel = 0.05;        // ... plus this fraction of the inverse depth (uneven ground)
   double max_rel_sigma = 0.1;      // tracks whose inverse depth is less precise than this are not used (fraction)
@@ -72,7 +72,7 @@ struct PairGroundOptions {
     v("with_map", &with_map, "also when the world motion comes with a map's scale and depth bounds (else only before a map)");
     v("max_tilt_deg", &max_tilt_deg, "normal at most this far from the reference camera's down axis (deg)");
     v("min_inliers", &min_inliers, "fewer tracks on the plane: no plane (count)");
-    v("min_inlier_share", &min_inlier_share, "inlier share of the tracks with a measured inverse depth [0, 1]");
+    v("min_inlier_share", &min_inlier_share, "inlier share of the tracks with a precise inverse depth [0, 1]");
     v("inlier_sigmas", &inlier_sigmas, "inverse-depth residual of an inlier (its standard deviations)");
     v("inlier_rel", &inlier_rel, "... plus this fraction of the inverse depth (fraction)");
     v("max_rel_sigma", &max_rel_sigma, "tracks with a less precise inverse depth are not used (fraction)");
@@ -93,7 +93,7 @@ struct PairGroundOptions {
 struct PairGroundPlane {
   Eigen::Vector3d m = Eigen::Vector3d::Zero();
   int inliers = 0;
-  int candidates = 0;             // tracks whose inverse depth was measured
+  int candidates = 0;             // tracks whose inverse depth was precise enough to fit
   double median_parallax_px = 0;  // of the inliers
 };
 

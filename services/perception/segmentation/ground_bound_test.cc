@@ -62,6 +62,32 @@ TEST(PairGround, InverseDepthOfAPointIsExactWithoutNoise) {
   EXPECT_GT(checked, 100);
 }
 
+// The inverse depth's standard deviation is that of its estimates over noisy draws.
+TEST(PairGround, InverseDepthSigmaMatchesItsSpread) {
+  const Pair pair(1.5);  // a long step: the current depth differs from the reference one
+  std::mt19937 rng(5);
+  const double noise_px = 0.7;
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(1.5, 0.8, 4.0), Eigen::Vector3d(-2.0, 0.8, 9.0)}) {
+    double sum = 0.0, sum2 = 0.0, sigma_sum = 0.0;
+    const int n = 4000;
+    // Noise on the current position only, as the model assumes.
+    Eigen::Vector2d xr, xn0;
+    ASSERT_TRUE(pair.Observe(p, 0.0, &rng, &xr, &xn0));
+    std::normal_distribution<double> g(0.0, noise_px / kFocal);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector2d xn = xn0 + Eigen::Vector2d(g(rng), g(rng));
+      double s = 0.0, sigma = 0.0;
+      ASSERT_TRUE(PairInverseDepth(xr, xn, pair.R, pair.t, noise_px / kFocal, &s, &sigma));
+      sum += s;
+      sum2 += s * s;
+      sigma_sum += sigma;
+    }
+    const double mean = sum / n, spread = std::sqrt(sum2 / n - mean * mean);
+    EXPECT_NEAR(sigma_sum / n, spread, 0.2 * spread) << p.transpose();
+    EXPECT_NEAR(mean, 1.0 / (pair.cam_from_level * p).z(), 3.0 * spread / std::sqrt(n) + 1e-3 * mean);
+  }
+}
+
 struct Observations {
   std::vector<Eigen::Vector2d> xr, xn;
 };
@@ -138,6 +164,20 @@ TEST(PairGround, NoPlaneInACloudOrAFacade) {
     }
   }
   EXPECT_FALSE(FitPairGroundPlane(facade.xr, facade.xn, pair.R, pair.t, kFocal, 1.0, PairGroundOptions()));
+  // A ceiling (a plane above the camera) is not the ground, however well it fits.
+  Observations ceiling;
+  std::uniform_real_distribution<double> cx2(-6, 6), cz2(2.0, 30.0);
+  for (int i = 0; i < 400; ++i) {
+    Eigen::Vector2d xr, xn;
+    if (pair.Observe(Eigen::Vector3d(cx2(rng), -2.0, cz2(rng)), 0.7, &rng, &xr, &xn)) {
+      ceiling.xr.push_back(xr);
+      ceiling.xn.push_back(xn);
+    }
+  }
+  PairGroundOptions any_tilt;
+  any_tilt.max_tilt_deg = 89.0;
+  EXPECT_GT(ceiling.xr.size(), 100u);
+  EXPECT_FALSE(FitPairGroundPlane(ceiling.xr, ceiling.xn, pair.R, pair.t, kFocal, 1.0, any_tilt));
   // Non-finite positions are skipped, not fitted.
   Observations with_nan;
   AddGround(pair, 300, &rng, &with_nan);
