@@ -130,8 +130,15 @@ void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
        ++it, ++kfs) {
     candidates.insert(it->second.point_ids.begin(), it->second.point_ids.end());
   }
+  // For the debug log only: the held points whose tracks are no longer active (the
+  // tracker does not report a track's end to the map; see below).
+  std::unordered_set<int64_t> active;
+  const bool debug = GetLogLevel() <= LogLevel::kDebug;
+  if (debug) {
+    for (const SlamObservation& o : frame.observations) active.insert(o.track_id);
+  }
   const int margin = options_.guided_radius_px + 8;
-  int searched = 0, tracked = 0, outside = 0, ambiguous = 0, unlike = 0;
+  int searched = 0, tracked = 0, ended = 0, outside = 0, ambiguous = 0, unlike = 0;
   for (int64_t pid : candidates) {
     if (searched >= options_.guided_max_points) break;
     const MapPoint* p = map_.point(pid);
@@ -143,6 +150,7 @@ void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
     // TartanAir's mean ATE over five starts 1.09 -> 1.73 %.
     if (p->track_id >= 0) {
       ++tracked;
+      if (debug && !active.count(p->track_id)) ++ended;
       continue;
     }
     const Eigen::Vector3d pc = T * p->position;
@@ -173,7 +181,8 @@ void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
     xy->push_back(K.PixelToNormalized(m.uv.cast<double>()));
   }
   MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": guided matching over " << candidates.size()
-                    << " points of the last keyframes: " << tracked << " tracked, " << outside << " outside, "
+                    << " points of the last keyframes: " << tracked << " held by tracks (" << ended
+                    << " of them ended), " << outside << " outside, "
                     << searched << " searched, " << ambiguous << " ambiguous, " << unlike << " unlike, "
                     << point_ids->size() << " re-found";
 }
@@ -884,7 +893,7 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
   const int64_t kid = map_.AddKeyframe(std::move(kf));
   const Keyframe& k = *map_.keyframe(kid);
   const double max_err = options_.triangulation_max_error_px / frame.focal_px;
-  int tracked = 0;
+  int tracked = 0, unseen = 0, degenerate = 0, low_parallax = 0, reprojection = 0;
   for (const auto& [track, x] : k.track_xy) {
     const int64_t pid = map_.PointOfTrack(track);
     if (pid >= 0) {
@@ -902,12 +911,22 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
       if (it->first == kid) continue;
       if (it->second.track_xy.count(track)) first = &it->second;
     }
-    if (!first) continue;
+    if (!first) {
+      ++unseen;
+      continue;
+    }
     const Eigen::Vector2d& x0 = first->track_xy.at(track);
     const std::optional<Eigen::Vector3d> X = TriangulateDlt(first->cam_from_world, x0, T, x);
-    if (!X) continue;
-    if (ParallaxAngle(first->cam_from_world, T, *X) < options_.triangulation_min_angle_deg * kDeg) continue;
+    if (!X) {
+      ++degenerate;
+      continue;
+    }
+    if (ParallaxAngle(first->cam_from_world, T, *X) < options_.triangulation_min_angle_deg * kDeg) {
+      ++low_parallax;
+      continue;
+    }
     if (ReprojectionError(first->cam_from_world, *X, x0) > max_err || ReprojectionError(T, *X, x) > max_err) {
+      ++reprojection;
       continue;
     }
     MapPoint p;
@@ -928,6 +947,10 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
     update->new_point_ids.push_back(new_pid);
   }
   tracked_points_at_keyframe_ = tracked + static_cast<int>(update->new_point_ids.size());
+  MBSLAM_LOG(DEBUG) << "SLAM keyframe at image " << frame.frame_index << ": " << k.track_xy.size() << " static tracks, "
+                    << tracked << " on points, " << update->new_point_ids.size() << " new points; not triangulated: "
+                    << unseen << " unseen by the last keyframes, " << degenerate << " degenerate, " << low_parallax
+                    << " low parallax, " << reprojection << " reprojection";
   last_keyframe_frame_ = frame.frame_index;
   update->new_keyframe = true;
   update->culled_points = CullKeyframes(frame.frame_index);
