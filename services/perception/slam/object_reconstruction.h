@@ -36,6 +36,7 @@ struct ObjectReconstructionOptions {
   int init_min_points = 20;       // ... points triangulated by it (count)
   double init_min_parallax_deg = 2.0;  // ... median parallax of the two views (deg)
   int min_tracking_inliers = 12;  // ... fewer inliers = its tracking is lost (count)
+  int lost_frames_to_reinit = 10; // ... frames lost before it re-initialises (its own: a quick restart splits a briefly seen object into short maps)
   int max_keyframes = 30;         // ... keyframes kept (count)
   // An object's tracks are short-lived (it is small and turns its sides): its points are
   // only triangulated between keyframes, so they come more often than the world's.
@@ -87,6 +88,7 @@ struct ObjectReconstructionOptions {
     MBSLAM_CHECK_OPTION_GE(init_min_points, 8);
     MBSLAM_CHECK_OPTION_GT(init_min_parallax_deg, 0.0);
     MBSLAM_CHECK_OPTION_GE(min_tracking_inliers, 6);
+    MBSLAM_CHECK_OPTION_GE(lost_frames_to_reinit, 1);
     MBSLAM_CHECK_OPTION_GE(max_keyframes, 3);
     MBSLAM_CHECK_OPTION_GE(keyframe_max_frames, 3);
     MBSLAM_CHECK_OPTION_GT(keyframe_parallax_deg, 0.0);
@@ -108,6 +110,7 @@ struct ObjectReconstructionOptions {
     v("init_min_points", &init_min_points, "object SLAM: points the initialisation must triangulate (count)");
     v("init_min_parallax_deg", &init_min_parallax_deg, "object SLAM: median parallax of the initial views (deg)");
     v("min_tracking_inliers", &min_tracking_inliers, "object SLAM: fewer inliers = lost (count)");
+    v("lost_frames_to_reinit", &lost_frames_to_reinit, "object SLAM: frames lost before re-initialising (frames)");
     v("max_keyframes", &max_keyframes, "object SLAM: keyframes kept (count)");
     v("keyframe_max_frames", &keyframe_max_frames, "object SLAM: a keyframe at least this often (frames)");
     v("keyframe_parallax_deg", &keyframe_parallax_deg, "object SLAM: parallax to the last keyframe that triggers one (deg)");

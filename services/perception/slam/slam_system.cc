@@ -344,6 +344,16 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
           b.twist_per_frame = (b.cam_from_world * PoseOf(prev->first)->Inverse()).Log() /
                               static_cast<double>(last->first - prev->first);
           b.metric = metric_;
+          if (const Keyframe* kf = map_.LastKeyframe()) {
+            std::vector<double> depths;
+            for (int64_t pid : kf->point_ids) {
+              const MapPoint* p = map_.point(pid);
+              if (!p) continue;
+              const double z = (b.cam_from_world * p->position).z();
+              if (z > 0.0) depths.push_back(z);
+            }
+            if (depths.size() >= 8) b.median_depth = Median(depths);
+          }
           bridge = b;
         }
         RestartMap(bridge);
@@ -824,14 +834,25 @@ void SlamSystem::ApplyBridge(int64_t ref_frame, int64_t cur_frame) {
   const Bridge b = *bridge_;
   // The reference view's pose in the old world frame, carried over the gap.
   const Rigid3d ref_in_old = Rigid3d::Exp(b.twist_per_frame * static_cast<double>(ref_frame - b.frame)) * b.cam_from_world;
-  // Units: metric maps are already comparable; otherwise the new baseline takes the
-  // length the old velocity predicts for it.
+  // Units: metric maps are already comparable; otherwise (bridge_units) the new baseline
+  // takes the length the old velocity predicts for it, or the new points the median
+  // depth the old ones had in the last good view. A camera that speeds up or stops
+  // during the gap fools the first (TartanAir: a segment at 0.6x the scale after the
+  // camera accelerated 1.6x); an indoor scene's depth changes less.
   double scale = 1.0;
   const Keyframe* k1 = map_.LastKeyframe();
   if (!(b.metric && metric_) && k1 != nullptr) {
     const double predicted = Rigid3d::Exp(b.twist_per_frame).translation.norm() * static_cast<double>(cur_frame - ref_frame);
     const double measured = k1->cam_from_world.translation.norm();
     if (predicted > 1e-9 && measured > 1e-9) scale = predicted / measured;
+    if (options_.bridge_units == "depth" && b.median_depth > 0.0) {
+      // The new world frame is the reference view: its points' z are their depths there.
+      std::vector<double> depths;
+      for (const auto& [id, p] : map_.points()) {
+        if (p.position.z() > 0.0) depths.push_back(p.position.z());
+      }
+      if (depths.size() >= 8) scale = b.median_depth / Median(depths);
+    }
     metric_ = b.metric;
   }
   // X_old = ref_in_old^-1 * (scale * X_new): the new world frame is the reference camera.

@@ -92,7 +92,12 @@ struct SlamOptions {
   int hybrid_max_frames = 10;            // images in a row at most (frames)
   int hybrid_reference_frames = 5;       // each track is linked to the oldest of this many recent posed images that saw it (frames)
   double hybrid_length_sigma = 0.5;      // prior on the motion's length since the reference: its standard deviation as a share of the predicted length
-  int lost_frames_to_reinit = 10;        // frames lost before the map is dropped and re-initialised (frames)
+  int lost_frames_to_reinit = 3;         // frames lost before the map is dropped and re-initialised (frames)
+  // Units of the map that follows a loss (without metric scale): "speed" = its first
+  // baseline is as long as the last velocity predicts; "depth" = its points' median depth
+  // in its reference view equals that of the lost map's last keyframe points in the last
+  // good view (scenes keep their depth better than cameras their speed across a gap).
+  std::string bridge_units = "depth";
   int max_keyframes = 200;               // oldest keyframes are culled beyond this (count)
   int culled_point_max_unmatched_frames = 30;  // a point culling left in < 2 keyframes goes once its track has not matched it this long (frames)
   bool background_ba = true;             // local BA in a back-end thread (realtime); false: inline (deterministic)
@@ -151,6 +156,7 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION(hybrid_reference_frames >= 1 && hybrid_reference_frames <= 30);
     MBSLAM_CHECK_OPTION_GT(hybrid_length_sigma, 0.0);
     MBSLAM_CHECK_OPTION_GE(lost_frames_to_reinit, 1);
+    MBSLAM_CHECK_OPTION(bridge_units == "speed" || bridge_units == "depth");
     MBSLAM_CHECK_OPTION_GE(max_keyframes, 3);
     MBSLAM_CHECK_OPTION_GE(culled_point_max_unmatched_frames, 1);
     MBSLAM_CHECK_OPTION(depth_bound_margin > 0.0 && depth_bound_margin < 1.0);
@@ -202,6 +208,8 @@ struct SlamOptions {
     v("hybrid_length_sigma", &hybrid_length_sigma,
       "prior on the motion's length since the reference, standard deviation as a share of the predicted one");
     v("lost_frames_to_reinit", &lost_frames_to_reinit, "frames lost before re-initialising (frames)");
+    v("bridge_units", &bridge_units,
+      "units of the map after a loss: speed (its baseline from the last velocity) | depth (its median depth from the lost map's)");
     v("max_keyframes", &max_keyframes, "keyframes kept (count)");
     v("culled_point_max_unmatched_frames", &culled_point_max_unmatched_frames,
       "a point left in fewer than two keyframes by culling is removed once its track has not matched it "
@@ -409,6 +417,7 @@ class SlamSystem {
     int64_t frame = 0;            // last good frame
     Rigid3d cam_from_world;       // its pose (old world frame)
     Vector6d twist_per_frame = Vector6d::Zero();  // cam motion per frame (left, old units)
+    double median_depth = 0.0;    // of the last keyframe's points in the last good view (old units; 0 = none)
     bool metric = false;
   };
   std::optional<Bridge> bridge_;
