@@ -1,7 +1,9 @@
 // A map lost and re-initialised continues the lost map's world frame and units
 // (SlamOptions::bridge_units). Monocular, the new map's scale is unobservable across the
 // gap: "speed" assumes the camera kept its velocity, "depth" that the scene kept its
-// depth. Here the camera speeds up during the gap, in a scene of constant depth.
+// depth. Here the camera approaches the scene before the loss (the map's depths shrink,
+// so the right new units are not those of a fresh map, median depth 1) and slides
+// sideways 2.5x faster after it.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "services/perception/slam/object_reconstruction.h"
 #include "services/perception/slam/slam_system.h"
 
 namespace mbslam {
@@ -20,20 +23,22 @@ constexpr int kLostFrom = 30;   // no observations from here ...
 constexpr int kLostUntil = 36;  // ... to here (exclusive): the map is lost
 constexpr int kEnd = 80;
 
-// The camera slides along x, 4 cm per image before the loss and 10 cm after it, over a
-// band of points 4-10 m deep; the tracks after the loss are new (nothing links the maps).
+// The camera moves towards a band of points 6-16 m deep (skewed towards the near end),
+// 8 cm per image, until the loss, then slides along x 20 cm per image; the tracks after
+// the loss are new (nothing links the maps).
 struct Scene {
   std::vector<Eigen::Vector3d> points;
   explicit Scene(unsigned seed) {
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> ux(-4.0, 10.0), uy(-0.4, 0.4), uz(4.0, 10.0);
-    for (int i = 0; i < 2500; ++i) {
-      const double z = uz(rng);
+    std::uniform_real_distribution<double> ux(-4.0, 14.0), uy(-0.4, 0.4), u01(0.0, 1.0);
+    for (int i = 0; i < 3000; ++i) {
+      const double z = 6.0 + 10.0 * u01(rng) * u01(rng);
       points.emplace_back(ux(rng), uy(rng) * z, z);
     }
   }
-  static double CenterX(int f) {
-    return f < kLostFrom ? 0.04 * f : 0.04 * kLostFrom + 0.10 * (f - kLostFrom);
+  static Eigen::Vector3d Center(int f) {
+    return f < kLostFrom ? Eigen::Vector3d(0.0, 0.0, 0.08 * f)
+                         : Eigen::Vector3d(0.20 * (f - kLostFrom), 0.0, 0.08 * kLostFrom);
   }
   SlamFrame Frame(int f) const {
     SlamFrame frame;
@@ -42,7 +47,8 @@ struct Scene {
     frame.focal_px = kFocal;
     if (f >= kLostFrom && f < kLostUntil) return frame;
     for (size_t i = 0; i < points.size(); ++i) {
-      const Eigen::Vector3d p = points[i] - Eigen::Vector3d(CenterX(f), 0.0, 0.0);
+      const Eigen::Vector3d p = points[i] - Center(f);
+      if (p.z() < 0.5) continue;
       const Eigen::Vector2d xy = p.hnormalized();
       if (std::abs(xy.x()) > 0.6 || std::abs(xy.y()) > 0.45) continue;
       SlamObservation o;
@@ -63,7 +69,7 @@ double MedianStepRatio(const std::map<int, Eigen::Vector3d>& centres, int from, 
   for (int f = from; f + 1 < to; ++f) {
     auto a = centres.find(f), b = centres.find(f + 1);
     if (a == centres.end() || b == centres.end()) continue;
-    r.push_back((b->second - a->second).norm() / std::abs(Scene::CenterX(f + 1) - Scene::CenterX(f)));
+    r.push_back((b->second - a->second).norm() / (Scene::Center(f + 1) - Scene::Center(f)).norm());
   }
   if (r.empty()) return 0.0;
   std::nth_element(r.begin(), r.begin() + static_cast<long>(r.size() / 2), r.end());
@@ -105,6 +111,16 @@ TEST(SlamBridge, SpeedUnitsAssumeTheOldVelocity) {
   // that much larger (its baseline looks 2.5x shorter in them).
   const double ratio = UnitRatioAfterLoss("speed");
   EXPECT_NEAR(ratio, 0.4, 0.1);
+}
+
+TEST(SlamBridge, ObjectMapsKeepTheSpeedBridgeAndTheirOwnLossDelay) {
+  SlamOptions world;
+  ObjectReconstructionOptions objects;
+  objects.lost_frames_to_reinit = 7;
+  const SlamOptions s = ObjectReconstruction::ObjectSlamOptions(objects, world);
+  EXPECT_EQ(world.bridge_units, "depth");
+  EXPECT_EQ(s.bridge_units, "speed");
+  EXPECT_EQ(s.lost_frames_to_reinit, 7);
 }
 
 }  // namespace
