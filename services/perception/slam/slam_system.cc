@@ -334,6 +334,9 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
       state_ = SlamState::kLost;
       if (lost_frames_ >= options_.lost_frames_to_reinit) {
         MBSLAM_LOG(WARNING) << "SLAM: lost for " << lost_frames_ << " frames; re-initialising";
+        // A bundle adjustment still running is waited for by the restart anyway: its
+        // result is merged first, for the pose and the depths the bridge carries over.
+        MergeBundleAdjustment(/*wait=*/true);
         std::optional<Bridge> bridge;
         if (recent_poses_.size() >= 2) {
           auto last = recent_poses_.rbegin();
