@@ -113,7 +113,7 @@ TEST(SlamBridge, SpeedUnitsAssumeTheOldVelocity) {
   EXPECT_NEAR(ratio, 0.4, 0.1);
 }
 
-TEST(SlamBridge, ObjectMapsKeepTheSpeedBridgeAndTheirOwnLossDelay) {
+TEST(SlamBridge, ObjectMapsKeepTheSpeedBridgeTheirOwnLossDelayAndNoAssistedPoses) {
   SlamOptions world;
   ObjectReconstructionOptions objects;
   objects.lost_frames_to_reinit = 7;
@@ -121,6 +121,8 @@ TEST(SlamBridge, ObjectMapsKeepTheSpeedBridgeAndTheirOwnLossDelay) {
   EXPECT_EQ(world.bridge_units, "depth");
   EXPECT_EQ(s.bridge_units, "speed");
   EXPECT_EQ(s.lost_frames_to_reinit, 7);
+  EXPECT_TRUE(world.hybrid_tracking);
+  EXPECT_FALSE(s.hybrid_tracking);
 }
 
 }  // namespace

@@ -51,6 +51,10 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   // was no better on sim-multi's longest object map (trajectory 4.6 -> 4.0 %, shape
   // 53 -> 59 % of its size), so object maps keep the speed bridge.
   s.bridge_units = "speed";
+  // Nor do they take epipolar-assisted poses: an object's few, short tracks are what
+  // runs out, not the texture (with them, sim-multi's longest object map: trajectory
+  // 4.6 -> 10.8 %, shape 53 -> 646 % of its size).
+  s.hybrid_tracking = false;
   s.max_keyframes = options.max_keyframes;
   s.keyframe_max_frames = std::max(options.keyframe_max_frames, s.keyframe_min_frames);
   s.keyframe_parallax_deg = options.keyframe_parallax_deg;

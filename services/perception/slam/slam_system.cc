@@ -379,6 +379,14 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
   // refused as outliers by the robust estimate), to the oldest recent posed image that
   // saw it (the longest baseline).
   EpipolarLinks links;
+  // An edge's track slides along it: its link would pull the geometry (a track without
+  // a patch is kept).
+  std::unordered_set<int64_t> edge_like;
+  if (options_.hybrid_min_corner_ratio > 0.0) {
+    for (const SlamObservation& o : frame.observations) {
+      if (!o.patch.empty() && PatchCornerRatio(o.patch) < options_.hybrid_min_corner_ratio) edge_like.insert(o.track_id);
+    }
+  }
   std::vector<int64_t> ref_frames;
   std::vector<int> per_reference;
   std::unordered_set<int64_t> linked;
@@ -390,6 +398,7 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
     int count = 0;
     for (const SlamObservation& o : frame.observations) {
       if (o.body_id > 0 || linked.count(o.track_id)) continue;
+      if (edge_like.count(o.track_id)) continue;
       auto it = seen.find(o.track_id);
       if (it == seen.end()) continue;
       linked.insert(o.track_id);

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <algorithm>
 #include <iostream>
 #include <map>
@@ -326,6 +328,33 @@ TEST(PatchMatcher, ExtractPatchIsGetRectSubPixBitForBit) {
     EXPECT_FALSE(ExtractPatch(image, {half - 0.01f, 50.0f}, size, &none));
     EXPECT_FALSE(ExtractPatch(image, {50.0f, 119.0f - half + 0.01f}, size, &none));
   }
+}
+
+TEST(PatchMatcher, CornerRatioTellsCornersFromEdges) {
+  // A corner (two perpendicular edges), a blurred edge at 30 deg (as a camera sees one),
+  // a flat patch, a textured one.
+  cv::Mat corner(11, 11, CV_8UC1, cv::Scalar(40)), edge(11, 11, CV_8UC1);
+  corner(cv::Rect(5, 5, 6, 6)).setTo(200);
+  for (int y = 0; y < 11; ++y) {
+    for (int x = 0; x < 11; ++x) {
+      const double d = (x - 5) * 0.5 - (y - 5) * 0.866;  // signed distance to the edge (px)
+      edge.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(120.0 + 80.0 * std::tanh(d));
+    }
+  }
+  const cv::Mat flat(11, 11, CV_8UC1, cv::Scalar(90));
+  cv::Mat textured;
+  ASSERT_TRUE(ExtractPatch(Texture(60, 60, 3), {30.0f, 30.0f}, 11, &textured));
+  EXPECT_GT(PatchCornerRatio(corner), 0.3);
+  EXPECT_LT(PatchCornerRatio(edge), 0.05);
+  EXPECT_EQ(PatchCornerRatio(flat), 0.0);
+  EXPECT_GT(PatchCornerRatio(textured), 0.1);
+  EXPECT_EQ(PatchCornerRatio(cv::Mat()), 0.0);
+  // Invariant to contrast and to the patch's type.
+  cv::Mat scaled, as_float;
+  corner.convertTo(scaled, CV_8U, 0.5, 10.0);
+  corner.convertTo(as_float, CV_32F);
+  EXPECT_NEAR(PatchCornerRatio(scaled), PatchCornerRatio(corner), 1e-2);
+  EXPECT_NEAR(PatchCornerRatio(as_float), PatchCornerRatio(corner), 1e-12);
 }
 
 TEST(PatchMatcher, FindsShiftedPatch) {

@@ -345,4 +345,25 @@ PatchAlignment AlignPatch(const cv::Mat& image, const cv::Mat& templ, const Eige
   return out;
 }
 
+double PatchCornerRatio(const cv::Mat& patch) {
+  if (patch.empty() || patch.rows < 3 || patch.cols < 3 || patch.channels() != 1) return 0.0;
+  cv::Mat f;
+  patch.convertTo(f, CV_64F);
+  double a = 0.0, b = 0.0, c = 0.0;
+  for (int y = 1; y + 1 < f.rows; ++y) {
+    for (int x = 1; x + 1 < f.cols; ++x) {
+      const double gx = 0.5 * (f.at<double>(y, x + 1) - f.at<double>(y, x - 1));
+      const double gy = 0.5 * (f.at<double>(y + 1, x) - f.at<double>(y - 1, x));
+      a += gx * gx;
+      b += gx * gy;
+      c += gy * gy;
+    }
+  }
+  const double half_trace = 0.5 * (a + c);
+  const double disc = std::sqrt(std::max(0.0, half_trace * half_trace - (a * c - b * b)));
+  const double large = half_trace + disc;
+  if (!(large > 0.0)) return 0.0;
+  return std::max(0.0, half_trace - disc) / large;
+}
+
 }  // namespace mbslam

@@ -16,6 +16,11 @@ bool ExtractPatch(const cv::Mat& image, const Eigen::Vector2f& uv, int size, cv:
 // either is flat.
 float PatchNcc(const cv::Mat& a, const cv::Mat& b);
 
+// Cornerness of a patch: the smaller over the larger eigenvalue of its structure tensor
+// (central differences over the interior), in [0, 1]; 0 for a flat or too small patch. An
+// edge is near 0: a track on it can slide along it.
+double PatchCornerRatio(const cv::Mat& patch);
+
 struct PatchMatch {
   Eigen::Vector2f uv = Eigen::Vector2f::Zero();  // best position (px)
   float score = 0.0f;   // mean squared zero-mean difference per pixel (gray levels^2)
