@@ -384,7 +384,8 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
   std::unordered_set<int64_t> edge_like;
   if (options_.hybrid_min_corner_ratio > 0.0) {
     for (const SlamObservation& o : frame.observations) {
-      if (!o.patch.empty() && PatchCornerRatio(o.patch) < options_.hybrid_min_corner_ratio) edge_like.insert(o.track_id);
+      if (o.body_id > 0 || o.patch.empty()) continue;  // never linked / no evidence
+      if (PatchCornerRatio(o.patch) < options_.hybrid_min_corner_ratio) edge_like.insert(o.track_id);
     }
   }
   std::vector<int64_t> ref_frames;
@@ -411,7 +412,11 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
     per_reference.push_back(count);
     links.references.push_back(*T);
   }
-  if (static_cast<int>(links.xy_ref.size()) < options_.hybrid_min_links) return false;
+  if (static_cast<int>(links.xy_ref.size()) < options_.hybrid_min_links) {
+    MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": epipolar-assisted pose refused, " << links.xy_ref.size()
+                      << " tracks linked (" << edge_like.size() << " edge-like tracks left out)";
+    return false;
+  }
   const int start_reference = static_cast<int>(
       std::max_element(per_reference.begin(), per_reference.end()) - per_reference.begin());
   const int length_reference = static_cast<int>(ref_frames.size()) - 1;
@@ -445,7 +450,8 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
   MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": epipolar-assisted pose, " << h.num_link_inliers
                     << " of " << links.xy_ref.size() << " tracks linked to images " << ref_frames.front() << "-"
                     << ref_frames.back() << " (rms " << h.link_rms_px << " px), " << h.pose.num_inliers << " of "
-                    << X.size() << " map points" << (ok ? "" : ": refused");
+                    << X.size() << " map points, " << edge_like.size() << " edge-like tracks left out"
+                    << (ok ? "" : ": refused");
   if (!ok) return false;
   *est = h.pose;
   return true;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include <algorithm>
 #include <iostream>
@@ -355,6 +356,31 @@ TEST(PatchMatcher, CornerRatioTellsCornersFromEdges) {
   corner.convertTo(as_float, CV_32F);
   EXPECT_NEAR(PatchCornerRatio(scaled), PatchCornerRatio(corner), 1e-2);
   EXPECT_NEAR(PatchCornerRatio(as_float), PatchCornerRatio(corner), 1e-12);
+  // Known values: f = x^2 + y^2 has an isotropic tensor (1), f = x^2 + 2 y^2 has its
+  // eigenvalues in the ratio 1 : 4 (central differences are exact on quadratics).
+  cv::Mat iso(11, 11, CV_64F), aniso(11, 11, CV_64F);
+  for (int y = 0; y < 11; ++y) {
+    for (int x = 0; x < 11; ++x) {
+      iso.at<double>(y, x) = (x - 5) * (x - 5) + (y - 5) * (y - 5);
+      aniso.at<double>(y, x) = (x - 5) * (x - 5) + 2.0 * (y - 5) * (y - 5);
+    }
+  }
+  EXPECT_NEAR(PatchCornerRatio(iso), 1.0, 1e-12);
+  EXPECT_NEAR(PatchCornerRatio(aniso), 0.25, 1e-12);
+  // Rotation by 90 deg and a corner in the outer ring change nothing / still count.
+  cv::Mat rotated;
+  cv::rotate(corner, rotated, cv::ROTATE_90_CLOCKWISE);
+  EXPECT_NEAR(PatchCornerRatio(rotated), PatchCornerRatio(corner), 1e-12);
+  cv::Mat rim(11, 11, CV_8UC1, cv::Scalar(40));
+  rim(cv::Rect(0, 0, 2, 2)).setTo(200);
+  EXPECT_GT(PatchCornerRatio(rim), 0.3);
+  // Not a grey patch, or not finite: no evidence of a corner.
+  cv::Mat colour(11, 11, CV_8UC3, cv::Scalar(40, 40, 40));
+  colour(cv::Rect(0, 0, 6, 6)).setTo(cv::Scalar(200, 200, 200));
+  EXPECT_EQ(PatchCornerRatio(colour), 0.0);
+  cv::Mat with_inf = iso.clone();
+  with_inf.at<double>(5, 5) = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(PatchCornerRatio(with_inf), 0.0);
 }
 
 TEST(PatchMatcher, FindsShiftedPatch) {

@@ -359,8 +359,9 @@ double PatchCornerRatio(const cv::Mat& patch) {
       c += gy * gy;
     }
   }
+  if (!std::isfinite(a + b + c)) return 0.0;
   const double half_trace = 0.5 * (a + c);
-  const double disc = std::sqrt(std::max(0.0, half_trace * half_trace - (a * c - b * b)));
+  const double disc = std::hypot(0.5 * (a - c), b);  // no cancellation, never negative
   const double large = half_trace + disc;
   if (!(large > 0.0)) return 0.0;
   return std::max(0.0, half_trace - disc) / large;
