@@ -13,9 +13,14 @@ eval_scenario() {
   local cam_height
   cam_height=$(awk '!/^#/ && NF >= 8 {s += $4; n++} END {if (n) printf "%.3f", s / n; else print 0}' "$seq/cam_trajectory.tum")
   run_service "$seq/sequence.lcmlog" "$MBSLAM_EVAL_OUT/run" --set "objects.camera_height_m=$cam_height" ${SERVICE_ARGS:-}
-  local ate seg ate_nf="{}" seg_epi="{}" occ="{}" obj="{}" obj05="{}" rec="{}"
+  local ate ate_live="{}" ate_nf_live="{}" seg ate_nf="{}" seg_epi="{}" occ="{}" obj="{}" obj05="{}" rec="{}"
   ate=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/run/result/camera_trajectory.tum" \
         --gt-sequence "$seq" --plot "$MBSLAM_EVAL_OUT/trajectory.png")
+  # The poses as published live (the trajectory file follows the later bundle adjustments).
+  if [[ -s "$MBSLAM_EVAL_OUT/run/result/camera_trajectory_live.tum" ]]; then
+    ate_live=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/run/result/camera_trajectory_live.tum" \
+               --gt-sequence "$seq")
+  fi
   seg=$(last_json "$MBSLAM_BIN/mbslam-eval-segmentation" --run "$MBSLAM_EVAL_OUT/run/out.lcmlog" --sequence "$seq" --name "$name")
   if [[ -f "$MBSLAM_EVAL_OUT/run/result/occupancy.bt" ]]; then
     occ=$(last_json "$MBSLAM_BIN/mbslam-eval-occupancy" --bt "$MBSLAM_EVAL_OUT/run/result/occupancy.bt" \
@@ -38,6 +43,10 @@ eval_scenario() {
       ${SERVICE_ARGS:-} --set slam.use_segmentation=false
     ate_nf=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/no_feedback/result/camera_trajectory.tum" \
              --gt-sequence "$seq")
+    if [[ -s "$MBSLAM_EVAL_OUT/no_feedback/result/camera_trajectory_live.tum" ]]; then
+      ate_nf_live=$(last_json "$MBSLAM_BIN/mbslam-eval" ate \
+                    --est "$MBSLAM_EVAL_OUT/no_feedback/result/camera_trajectory_live.tum" --gt-sequence "$seq")
+    fi
   fi
   if [[ "${FVB_ABLATION:-0}" == "1" ]]; then
     # The same options, the Flow Vector Bound off: what the epipolar constraint alone finds.
@@ -48,7 +57,7 @@ eval_scenario() {
   fi
   local len
   len=$(path_length "$seq/cam_trajectory.tum")
-  python3 - "$name" "$ate" "$seg" "$ate_nf" "$len" "$MBSLAM_EVAL_OUT/run/result/summary.json" "$occ" "$obj" "$obj05" "$cam_height" "$rec" "$seg_epi" <<'PY'
+  python3 - "$name" "$ate" "$seg" "$ate_nf" "$len" "$MBSLAM_EVAL_OUT/run/result/summary.json" "$occ" "$obj" "$obj05" "$cam_height" "$rec" "$seg_epi" "$ate_live" "$ate_nf_live" <<'PY'
 import json, sys
 name, ate, seg, ate_nf, length = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3]), json.loads(sys.argv[4]), float(sys.argv[5])
 summary = json.load(open(sys.argv[6]))
@@ -62,6 +71,8 @@ scales = [o["relative_scale_error"] for o in objs if o.get("settled_samples", 0)
 rmse = ate.get("ate_rmse_m")
 out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float(sys.argv[10]),
        "ate_rmse_m": rmse, "ate_rel_path": rmse / length if (rmse is not None and length > 0) else None,
+       "ate_rel_path_live": (json.loads(sys.argv[13] or "{}").get("ate_rmse_m") or 0) / length
+                            if (json.loads(sys.argv[13] or "{}").get("ate_rmse_m") is not None and length > 0) else None,
        "tracked_fraction": ate.get("fraction_tracked"), "sim3_scale": ate.get("scale"),
        "moving_recall": seg.get("moving_recall"), "moving_precision": seg.get("moving_precision"),
        "false_moving_fraction": seg.get("false_moving_fraction"),
@@ -101,10 +112,13 @@ if seg_epi:
     out["detection_delay_frames_epipolar_only"] = seg_epi.get("detection_delay_frames")
 if ate_nf:
     out["ate_rel_path_no_feedback"] = ate_nf["ate_rmse_m"] / length if ("ate_rmse_m" in ate_nf and length > 0) else None
+    ate_nf_live = json.loads(sys.argv[14] or "{}")
+    out["ate_rel_path_no_feedback_live"] = (ate_nf_live["ate_rmse_m"] / length
+                                            if ("ate_rmse_m" in ate_nf_live and length > 0) else None)
     out["tracked_fraction_no_feedback"] = ate_nf.get("fraction_tracked")
 def pct(v):
     return "n/a" if v is None else f"{100*v:.3f} %"
-print(f"sim-{name}: ATE {pct(out['ate_rel_path'])} of {length:.2f} m, tracked {pct(out['tracked_fraction'])}, "
+print(f"sim-{name}: ATE {pct(out['ate_rel_path'])} of {length:.2f} m (live poses {pct(out['ate_rel_path_live'])}), tracked {pct(out['tracked_fraction'])}, "
       f"moving recall {out['moving_recall']}, precision {out['moving_precision']}, false moving {out['false_moving_fraction']}")
 if obj:
     print(f"  objects: {obj.get('est_objects')} estimated, {obj.get('matched')} matched of {obj.get('gt_bodies')}; "
@@ -124,7 +138,8 @@ if rec.get("scored"):
 if occ:
     print(f"  occupancy: precision {occ.get('occupancy_precision')}, recall {occ.get('occupancy_recall')} (voxel {occ.get('resolution_m')} m)")
 if ate_nf:
-    print(f"  without segmentation feedback: ATE {pct(out.get('ate_rel_path_no_feedback'))}, tracked {pct(out.get('tracked_fraction_no_feedback'))}")
+    print(f"  without segmentation feedback: ATE {pct(out.get('ate_rel_path_no_feedback'))} "
+          f"(live poses {pct(out.get('ate_rel_path_no_feedback_live'))}), tracked {pct(out.get('tracked_fraction_no_feedback'))}")
 if seg_epi:
     print(f"  epipolar constraint alone (no FVB): moving recall {out['moving_recall_epipolar_only']}, "
           f"precision {out['moving_precision_epipolar_only']}")

@@ -12,9 +12,11 @@
 # this sequence: a change is judged on the mean over starts, not on one replay.
 # JSON (last line): {"tartanair": {"frames", "tracked_fraction" (live poses / images),
 #   "posed_fraction" (trajectory file / images), "ate_rmse_m", "ate_rel_path",
-#   "path_length_m" (all of the first start); with several starts also "starts" (the same
-#   keys per start) and "tracked_fraction_mean", "posed_fraction_mean",
-#   "ate_rel_path_mean", "ate_rel_path_median"}, "tum-cabinet": {...}}
+#   "path_length_m" (all of the first start), "ate_rel_path_live" (the poses as published
+#   live, without the later bundle adjustments the trajectory file follows); with several
+#   starts also "starts" (the same keys per start) and "tracked_fraction_mean",
+#   "posed_fraction_mean", "ate_rel_path_mean", "ate_rel_path_live_mean",
+#   "ate_rel_path_median"}, "tum-cabinet": {...}}
 set -euo pipefail
 source "$(dirname "$0")/_lib.sh"
 sequences="tartanair tum-cabinet"
@@ -64,15 +66,19 @@ run_one() {
   "$MBSLAM_BIN/camera_driver" --source "$source_kind" --input "$data" "${rate_args[@]}" \
     --calibration "$MBSLAM_ROOT/$calib" --log "$log" --quiet --no-progress --log-level warning >&2
   run_service "$log" "$dir/run" ${SERVICE_ARGS:-}
-  local ate length
+  local ate ate_live="{}" length
   ate=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$dir/run/result/camera_trajectory.tum" --gt-log "$log" \
         --plot "$dir/trajectory.png")
+  if [[ -s "$dir/run/result/camera_trajectory_live.tum" ]]; then
+    ate_live=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$dir/run/result/camera_trajectory_live.tum" --gt-log "$log")
+  fi
   length=$(awk -v a="$c1" -v b="$c2" -v c="$c3" '!/^#/ && NF >= 7 {
              if (n++) {dx = $a - x; dy = $b - y; dz = $c - z; L += sqrt(dx*dx + dy*dy + dz*dz)}
              x = $a; y = $b; z = $c} END {printf "%.6f\n", L}' "$truth")
-  python3 - "$name" "$dir/run/result/summary.json" "$length" "$ate" <<'PY'
+  python3 - "$name" "$dir/run/result/summary.json" "$length" "$ate" "$ate_live" <<'PY'
 import json, sys
 name, summary_path, length, ate = sys.argv[1], sys.argv[2], float(sys.argv[3]), json.loads(sys.argv[4] or "{}")
+ate_live = json.loads(sys.argv[5] or "{}")
 s = json.load(open(summary_path))
 rmse = ate.get("ate_rmse_m")
 r = {"frames": s["frames"], "tracked_fraction": round(s["tracked_fraction"], 4),
@@ -80,6 +86,8 @@ r = {"frames": s["frames"], "tracked_fraction": round(s["tracked_fraction"], 4),
      "ate_rmse_m": rmse, "path_length_m": round(length, 3),
      "ate_rel_path": None if rmse is None or length <= 0 else rmse / length,
      "trajectory_fraction_scored": ate.get("fraction_tracked")}
+rmse_live = ate_live.get("ate_rmse_m")
+r["ate_rel_path_live"] = None if rmse_live is None or length <= 0 else rmse_live / length
 print(f"{name}: {s['frames']} images, live poses {100 * r['tracked_fraction']:.1f} %, trajectory file "
       f"{100 * r['posed_fraction']:.1f} %, ATE {rmse} m = "
       f"{'n/a' if r['ate_rel_path'] is None else round(100 * r['ate_rel_path'], 2)} % of the {length:.2f} m path",
@@ -121,7 +129,7 @@ runs = {int(rest[i]): json.loads(rest[i + 1]) for i in range(0, len(rest), 2)}
 first = runs[min(runs)] if 0 not in runs else runs[0]
 out = dict(first)
 out["starts"] = {str(k): v for k, v in runs.items()}
-for key in ("tracked_fraction", "posed_fraction", "ate_rel_path"):
+for key in ("tracked_fraction", "posed_fraction", "ate_rel_path", "ate_rel_path_live"):
     vals = [v[key] for v in runs.values() if v.get(key) is not None]
     out[key + "_mean"] = statistics.mean(vals) if vals else None
 vals = [v["ate_rel_path"] for v in runs.values() if v.get("ate_rel_path") is not None]

@@ -15,6 +15,9 @@ class FrameProcessor {
   virtual FrameResult ProcessFrame(const ImageFrame& frame) = 0;
   // Called once after the last event (end of a replay or shutdown).
   virtual void Finish() {}
+  // After Finish(): the camera poses as the map finally has them ((utime,
+  // world_from_cam), oldest first; see OutputSink::OnAdjustedCameraTrajectory).
+  virtual std::vector<std::pair<int64_t, Rigid3d>> AdjustedCameraTrajectory() const { return {}; }
 };
 
 }  // namespace mbslam

@@ -47,6 +47,12 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
   base_from_cam_ = Rigid3d(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), Eigen::Vector3d(t[0], t[1], t[2]));
 }
 
+std::vector<std::pair<int64_t, Rigid3d>> PerceptionCore::AdjustedCameraTrajectory() const {
+  std::vector<std::pair<int64_t, Rigid3d>> out = slam_.AdjustedTrajectory();
+  for (auto& [utime, pose] : out) pose = pose.Inverse();  // world_from_cam
+  return out;
+}
+
 void PerceptionCore::Reset() {
   slam_.Reset();
   rereference_tracks_.clear();

@@ -131,6 +131,7 @@ class PerceptionCore : public FrameProcessor {
     slam_.Flush();
     object_reconstruction_->Flush();
   }
+  std::vector<std::pair<int64_t, Rigid3d>> AdjustedCameraTrajectory() const override;
 
  private:
   std::optional<RelativeMotion> OdometryMotion(int64_t ref_frame, int64_t cur_frame) const;

@@ -83,6 +83,8 @@ void PerceptionPipeline::Stop() {
   odometry_queue_.Shutdown();
   process_thread_.join();
   processor_->Finish();
+  const std::vector<std::pair<int64_t, Rigid3d>> adjusted = processor_->AdjustedCameraTrajectory();
+  if (!adjusted.empty()) sink_->OnAdjustedCameraTrajectory(adjusted);
 }
 
 void PerceptionPipeline::Push(InputEvent event) {

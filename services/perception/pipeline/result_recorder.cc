@@ -75,6 +75,12 @@ void ResultRecorder::OnFrameResult(const FrameResult& r) {
   if (r.occupancy) occupancy_ = r.occupancy;
 }
 
+void ResultRecorder::OnAdjustedCameraTrajectory(const std::vector<std::pair<int64_t, Rigid3d>>& world_from_cam) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  adjusted_camera_.clear();
+  for (const auto& [utime, pose] : world_from_cam) adjusted_camera_[utime] = pose;
+}
+
 int64_t ResultRecorder::frames() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return frames_;
@@ -102,11 +108,21 @@ Status ResultRecorder::Write(const std::string& dir, const std::string& extra_su
   // A process killed during an earlier save leaves its temporary files behind.
   RemoveStaleTempFiles(dir);
   RemoveStaleTempFiles(dir + "/objects");
+  int64_t adjusted = 0;
   {
-    std::ostringstream out;
+    // The images' poses as the map finally has them where it still does (after the
+    // last image), else as published.
+    std::ostringstream out, live;
     out << "# world_from_cam, TUM format: t tx ty tz qx qy qz qw\n";
-    for (const TimedPose& p : camera_) out << TumLine(p.utime, p.pose) << "\n";
+    live << "# world_from_cam as published live, TUM format: t tx ty tz qx qy qz qw\n";
+    for (const TimedPose& p : camera_) {
+      auto a = adjusted_camera_.find(p.utime);
+      adjusted += a != adjusted_camera_.end();
+      out << TumLine(p.utime, a != adjusted_camera_.end() ? a->second : p.pose) << "\n";
+      live << TumLine(p.utime, p.pose) << "\n";
+    }
     MBSLAM_RETURN_IF_ERROR(WriteStringAtomically(dir + "/camera_trajectory.tum", out.str()));
+    MBSLAM_RETURN_IF_ERROR(WriteStringAtomically(dir + "/camera_trajectory_live.tum", live.str()));
   }
   for (const auto& [id, poses] : objects_) {
     std::ostringstream out;
@@ -152,6 +168,7 @@ Status ResultRecorder::Write(const std::string& dir, const std::string& extra_su
   json << "{\n  \"frames\": " << frames_ << ",\n  \"frames_tracked\": " << tracked_
        << ",\n  \"tracked_fraction\": " << (frames_ ? double(tracked_) / frames_ : 0.0)
        << ",\n  \"frames_backfilled\": " << backfilled_
+       << ",\n  \"frames_adjusted\": " << adjusted
        << ",\n  \"posed_fraction\": " << (frames_ ? double(tracked_ + backfilled_) / frames_ : 0.0)
        << ",\n  \"first_utime\": " << first_utime_ << ",\n  \"last_utime\": " << last_utime_
        << ",\n  \"objects_with_trajectory\": " << objects_.size()

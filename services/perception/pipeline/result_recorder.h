@@ -3,7 +3,9 @@
 
 // Keeps what the output files need (camera and object trajectories, the latest map
 // and occupancy, run statistics) and writes them atomically on request or exit:
-//   camera_trajectory.tum, objects/<id>.tum, map.ply, occupancy.bt, summary.json
+//   camera_trajectory.tum (the poses as the map finally has them, where it does),
+//   camera_trajectory_live.tum (as published), objects/<id>.tum, map.ply, occupancy.bt,
+//   summary.json
 
 #include <deque>
 #include <map>
@@ -26,6 +28,9 @@ class ResultRecorder : public OutputSink {
   explicit ResultRecorder(size_t max_poses = kDefaultMaxPoses) : max_poses_(max_poses) {}
 
   void OnFrameResult(const FrameResult& result) override;
+  // The final adjusted poses replace the live ones of the same images in
+  // camera_trajectory.tum; camera_trajectory_live.tum keeps the poses as published.
+  void OnAdjustedCameraTrajectory(const std::vector<std::pair<int64_t, Rigid3d>>& world_from_cam) override;
 
   // Writes every output file into `dir` (created if missing). `extra_summary` is a
   // JSON object body (without braces) merged into summary.json; may be empty.
@@ -48,6 +53,7 @@ class ResultRecorder : public OutputSink {
   const size_t max_poses_;
   mutable std::mutex mutex_;
   std::deque<TimedPose> camera_;  // tracked frames only, oldest first
+  std::map<int64_t, Rigid3d> adjusted_camera_;  // utime -> world_from_cam, after the last image
   std::map<int, std::vector<TimedPose>> objects_;  // ids grow with time: begin() is the oldest
   size_t object_poses_ = 0;
   int64_t camera_poses_dropped_ = 0;
@@ -74,6 +80,9 @@ class TeeSink : public OutputSink {
   explicit TeeSink(std::vector<OutputSink*> sinks) : sinks_(std::move(sinks)) {}
   void OnFrameResult(const FrameResult& result) override {
     for (OutputSink* s : sinks_) s->OnFrameResult(result);
+  }
+  void OnAdjustedCameraTrajectory(const std::vector<std::pair<int64_t, Rigid3d>>& world_from_cam) override {
+    for (OutputSink* s : sinks_) s->OnAdjustedCameraTrajectory(world_from_cam);
   }
 
  private:

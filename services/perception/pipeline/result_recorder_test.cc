@@ -82,6 +82,52 @@ TEST(ResultRecorder, BackfilledPosesGoInTimeOrder) {
   EXPECT_NE(summary.find("\"frames_backfilled\": 3"), std::string::npos) << summary;
 }
 
+// The camera poses as the map finally has them replace the published ones of the same
+// images in camera_trajectory.tum; camera_trajectory_live.tum keeps what was published;
+// poses of images the recorder never had a pose for are not added.
+TEST(ResultRecorder, AdjustedPosesReplaceLiveOnesOfTheSameImages) {
+  ResultRecorder recorder;
+  for (int i = 0; i < 5; ++i) {
+    FrameResult r;
+    r.utime = 1000000 + i * 100000;
+    r.camera_pose.utime = r.utime;
+    r.camera_pose.tracking_state = i == 1 ? TrackingState::kLost : TrackingState::kOk;
+    r.camera_pose.world_from_cam.translation.x() = i;
+    recorder.OnFrameResult(r);
+  }
+  std::vector<std::pair<int64_t, Rigid3d>> adjusted;
+  for (int i : {1, 2, 4, 7}) {  // 1: lost live, 7: never seen
+    Rigid3d p;
+    p.translation.x() = 10 + i;
+    adjusted.emplace_back(1000000 + i * 100000, p);
+  }
+  recorder.OnAdjustedCameraTrajectory(adjusted);
+  char pattern[] = "/tmp/mbslam_rec_XXXXXX";
+  const std::string dir = mkdtemp(pattern);
+  ASSERT_TRUE(recorder.Write(dir, "").ok());
+  auto xs = [&](const std::string& file) {
+    std::string text;
+    EXPECT_TRUE(ReadFileToString(dir + "/" + file, &text).ok()) << file;
+    std::istringstream in(text);
+    std::string line;
+    std::vector<double> x;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream fields(line);
+      double t, tx;
+      fields >> t >> tx;
+      x.push_back(tx);
+    }
+    return x;
+  };
+  EXPECT_EQ(xs("camera_trajectory.tum"), (std::vector<double>{0, 12, 3, 14}));
+  EXPECT_EQ(xs("camera_trajectory_live.tum"), (std::vector<double>{0, 2, 3, 4}));
+  std::string summary;
+  ASSERT_TRUE(ReadFileToString(dir + "/summary.json", &summary).ok());
+  EXPECT_NE(summary.find("\"frames_adjusted\": 2"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"tracked_fraction\": 0.8"), std::string::npos) << summary;
+}
+
 TEST(ResultRecorder, TrajectoriesAreBoundedOldestDropped) {
   ResultRecorder recorder(/*max_poses=*/10);
   for (int i = 0; i < 25; ++i) {

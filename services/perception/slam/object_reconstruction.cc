@@ -74,6 +74,8 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   s.use_segmentation = true;
   s.map_load_path.clear();
   s.map_save_path.clear();
+  // Its trajectory file is written as tracked (no adjusted trajectory kept).
+  s.adjusted_trajectory_max_poses = 0;
   s.rotation_prior_floor_rad = options.rotation_prior_floor_rad;
   s.rotation_prior_rad_per_s = options.rotation_prior_rad_per_s;
   s.rotation_prior_min_inlier_ratio = options.rotation_prior_min_inlier_ratio;

@@ -59,6 +59,8 @@ void SlamSystem::Flush() { MergeBundleAdjustment(/*wait=*/true); }
 
 void SlamSystem::Reset() {
   Flush();
+  ResolveTrajectory(/*all_keyframes=*/true);
+  refine_obs_.clear();
   ++map_generation_;
   bridge_.reset();
   map_.Clear();
@@ -92,6 +94,7 @@ Status SlamSystem::SaveMap(const std::string& path) {
 
 Status SlamSystem::LoadMap(const std::string& path) {
   Flush();
+  ResolveTrajectory(/*all_keyframes=*/true);
   MBSLAM_RETURN_IF_ERROR(map_.Load(path));
   // A loaded map is only trusted after the camera relocalises against it; without
   // descriptors that means re-initialising, so it serves as a prior for display.
@@ -109,6 +112,76 @@ void SlamSystem::StorePose(int64_t frame, const Rigid3d& T, const Matrix6d& cova
   }
   recent_poses_[frame] = p;
   while (recent_poses_.size() > 64) recent_poses_.erase(recent_poses_.begin());
+  RecordTrajectory(frame, T, map_.LastKeyframe());
+}
+
+void SlamSystem::RecordTrajectory(int64_t frame, const Rigid3d& T, const Keyframe* anchor) {
+  if (options_.adjusted_trajectory_max_poses <= 0) return;
+  auto u = frame_utime_.find(frame);
+  if (u == frame_utime_.end()) return;
+  TrajectoryEntry e;
+  e.frame = frame;
+  e.utime = u->second;
+  e.cam_from_world = T;
+  if (anchor) {
+    e.anchor_keyframe = anchor->id;
+    e.cam_from_anchor = T * anchor->cam_from_world.Inverse();
+  }
+  trajectory_.push_back(e);
+  while (static_cast<int>(trajectory_.size()) > options_.adjusted_trajectory_max_poses) trajectory_.pop_front();
+}
+
+void SlamSystem::ResolveTrajectory(bool all_keyframes, int64_t keyframe_id) {
+  for (TrajectoryEntry& e : trajectory_) {
+    if (e.anchor_keyframe < 0 || (!all_keyframes && e.anchor_keyframe != keyframe_id)) continue;
+    if (const Keyframe* kf = map_.keyframe(e.anchor_keyframe)) e.cam_from_world = e.cam_from_anchor * kf->cam_from_world;
+    e.anchor_keyframe = -1;
+  }
+}
+
+void SlamSystem::RefineTrajectory() {
+  if (refine_obs_.empty() || options_.adjusted_trajectory_refine_keyframes <= 0) return;
+  std::set<int64_t> newest;
+  int64_t oldest_frame = std::numeric_limits<int64_t>::max();
+  for (auto k = map_.keyframes().rbegin();
+       k != map_.keyframes().rend() && static_cast<int>(newest.size()) < options_.adjusted_trajectory_refine_keyframes;
+       ++k) {
+    newest.insert(k->first);
+    oldest_frame = std::min(oldest_frame, k->second.frame_index);
+  }
+  // Images tracked before the oldest of them are done with.
+  refine_obs_.erase(refine_obs_.begin(), refine_obs_.lower_bound(oldest_frame));
+  if (refine_obs_.empty()) return;
+  const int64_t first = refine_obs_.begin()->first;
+  for (auto e = trajectory_.rbegin(); e != trajectory_.rend() && e->frame >= first; ++e) {
+    auto o = refine_obs_.find(e->frame);
+    if (o == refine_obs_.end() || !newest.count(e->anchor_keyframe)) continue;
+    const Keyframe* kf = map_.keyframe(e->anchor_keyframe);
+    if (!kf || kf->frame_index == e->frame) continue;  // a keyframe's image is the keyframe
+    std::vector<Eigen::Vector3d> X;
+    std::vector<Eigen::Vector2d> xy;
+    for (const auto& [pid, x] : o->second) {
+      const MapPoint* p = map_.point(pid);
+      if (!p) continue;
+      X.push_back(p->position);
+      xy.push_back(x);
+    }
+    if (static_cast<int>(X.size()) < options_.min_tracking_inliers) continue;
+    const std::vector<uint8_t> use(X.size(), 1);
+    const Rigid3d T = RefinePose(e->cam_from_anchor * kf->cam_from_world, X, xy, use, focal_px_,
+                                 options_.pose.huber_px, options_.pose.refine_iterations, nullptr);
+    if (!T.translation.allFinite() || !T.rotation.coeffs().allFinite()) continue;
+    e->cam_from_anchor = T * kf->cam_from_world.Inverse();
+  }
+}
+
+std::vector<std::pair<int64_t, Rigid3d>> SlamSystem::AdjustedTrajectory() const {
+  std::map<int64_t, Rigid3d> by_utime;
+  for (const TrajectoryEntry& e : trajectory_) {
+    const Keyframe* kf = e.anchor_keyframe >= 0 ? map_.keyframe(e.anchor_keyframe) : nullptr;
+    by_utime[e.utime] = kf ? e.cam_from_anchor * kf->cam_from_world : e.cam_from_world;
+  }
+  return {by_utime.begin(), by_utime.end()};
 }
 
 std::optional<Rigid3d> SlamSystem::PoseOf(int64_t frame) const {
@@ -215,6 +288,8 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   while (recent_odometry_.size() > 64) recent_odometry_.erase(recent_odometry_.begin());
   SlamPose out;
   if (!options_.enabled) return out;
+  frame_utime_[frame.frame_index] = frame.utime;
+  while (static_cast<int>(frame_utime_.size()) > options_.backfill_max_frames + 64) frame_utime_.erase(frame_utime_.begin());
   if (state_ == SlamState::kNotInitialized || state_ == SlamState::kInitializing) {
     TryInitialize(frame, &out);
     last_frame_ = frame.frame_index;
@@ -298,6 +373,16 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     out.num_refound = 0;
     out.epipolar_assisted = assisted;
     StorePose(frame.frame_index, est.cam_from_world, est.covariance);
+    if (options_.adjusted_trajectory_refine_keyframes > 0 && options_.adjusted_trajectory_max_poses > 0) {
+      auto& obs = refine_obs_[frame.frame_index];
+      obs.clear();
+      for (size_t i = 0; i < tracks.size(); ++i) {
+        if (i >= est.inliers.size() || !est.inliers[i]) continue;
+        const int64_t pid = tracks[i] >= 0 ? map_.PointOfTrack(tracks[i]) : refound_ids[static_cast<size_t>(-1 - tracks[i])];
+        if (pid >= 0) obs.emplace_back(pid, xy[i]);
+      }
+      while (refine_obs_.size() > 256) refine_obs_.erase(refine_obs_.begin());
+    }
     if (options_.hybrid_tracking) {
       auto& seen = posed_xy_[frame.frame_index];
       seen.clear();
@@ -493,6 +578,14 @@ void SlamSystem::BackfillPoses(int64_t frame, SlamPose* out) {
     MBSLAM_LOG(DEBUG) << "SLAM backfill of frame " << f << ": " << obs.size() << " observations, " << X.size()
                       << " with points, " << est.num_inliers << " inliers" << (est.ok ? "" : " (failed)");
     if (est.ok && est.num_inliers >= options_.min_tracking_inliers) out->backfilled.emplace_back(f, est.cam_from_world);
+  }
+  for (const auto& [f, T] : out->backfilled) {
+    // Anchored on the keyframe nearest in time.
+    const Keyframe* nearest = nullptr;
+    for (const auto& [id, k] : map_.keyframes()) {
+      if (!nearest || std::abs(k.frame_index - f) < std::abs(nearest->frame_index - f)) nearest = &k;
+    }
+    RecordTrajectory(f, T, nearest);
   }
   if (!out->backfilled.empty()) {
     MBSLAM_LOG(INFO) << "SLAM: poses of " << out->backfilled.size() << " of " << unposed_.size()
@@ -931,6 +1024,11 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
   }
   const int64_t kid = map_.AddKeyframe(std::move(kf));
   const Keyframe& k = *map_.keyframe(kid);
+  // The keyframe's image follows the keyframe itself in the adjusted trajectory.
+  if (!trajectory_.empty() && trajectory_.back().utime == frame.utime) {
+    trajectory_.back().anchor_keyframe = kid;
+    trajectory_.back().cam_from_anchor = Rigid3d();
+  }
   const double max_err = options_.triangulation_max_error_px / frame.focal_px;
   int tracked = 0, unseen = 0, degenerate = 0, low_parallax = 0, reprojection = 0;
   for (const auto& [track, x] : k.track_xy) {
@@ -1013,6 +1111,10 @@ std::optional<double> SlamSystem::EstablishMetricScale() {
   MergeBundleAdjustment(true);
   const double s = odo / slam;
   map_.Rescale(s);
+  for (TrajectoryEntry& e : trajectory_) {
+    e.cam_from_world.translation *= s;
+    e.cam_from_anchor.translation *= s;
+  }
   for (auto& [frame, pose] : recent_poses_) {
     pose.cam_from_world.translation *= s;
     pose.cam_from_anchor.translation *= s;
@@ -1043,6 +1145,7 @@ int SlamSystem::CullKeyframes(int64_t frame_index) {
         ++removed;
       }
     }
+    ResolveTrajectory(/*all_keyframes=*/false, id);
     map_.keyframes().erase(id);
     if (was_fixed && !map_.keyframes().empty()) map_.keyframes().begin()->second.fixed = true;
   }
@@ -1138,7 +1241,10 @@ void SlamSystem::StartBundleAdjustment(bool global) {
     const BaSummary s = SolveBa(&problem, options_.ba);
     ++ba_runs_;
     last_ba_seconds_ = s.seconds;
-    if (s.usable) ApplyBaResult(problem, options_.ba, &map_);
+    if (s.usable) {
+      ApplyBaResult(problem, options_.ba, &map_);
+      RefineTrajectory();
+    }
     return;
   }
   if (ba_running_) return;  // the next keyframe triggers another run
@@ -1162,7 +1268,10 @@ void SlamSystem::MergeBundleAdjustment(bool wait) {
   ba_thread_.join();
   ++ba_runs_;
   last_ba_seconds_ = ba_summary_.seconds;
-  if (ba_summary_.usable && ba_problem_) ApplyBaResult(*ba_problem_, options_.ba, &map_);
+  if (ba_summary_.usable && ba_problem_) {
+    ApplyBaResult(*ba_problem_, options_.ba, &map_);
+    RefineTrajectory();
+  }
   ba_problem_.reset();
 }
 

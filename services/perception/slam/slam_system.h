@@ -114,6 +114,17 @@ struct SlamOptions {
   int guided_radius_px = 10;             // search half-window around the predicted projection (px)
   double guided_min_ncc = 0.8;           // acceptance (normalised cross-correlation)
   int guided_max_points = 400;           // at most this many searches per image (count)
+  // The trajectory files hold each posed image's pose relative to the keyframe it was
+  // tracked from, composed with that keyframe's final (bundle-adjusted) pose
+  // (AdjustedTrajectory): an image's live pose cannot follow the corrections that later
+  // adjustments make to its keyframe. This many images at most, the oldest forgotten
+  // first (they keep their live poses in the files) (count; 0 = off).
+  int adjusted_trajectory_max_poses = 1 << 18;
+  // Images tracked since the last keyframes are also re-resected (motion-only, on their
+  // tracking inliers) against the map each time a bundle adjustment has moved it, while
+  // their keyframe is one of this many newest: a keyframe's adjustment corrects its
+  // points, which the images tracked on them do not see otherwise (0 = anchoring only).
+  int adjusted_trajectory_refine_keyframes = 2;
   std::string map_load_path;             // map loaded at start ("" = none)
   std::string map_save_path;             // map saved at exit ("" = none)
   // Images that carry a rotation prior (SlamFrame::rotation_prior) constrain the rotation
@@ -162,6 +173,8 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION(bridge_units == "speed" || bridge_units == "depth");
     MBSLAM_CHECK_OPTION_GE(max_keyframes, 3);
     MBSLAM_CHECK_OPTION_GE(culled_point_max_unmatched_frames, 1);
+    MBSLAM_CHECK_OPTION_GE(adjusted_trajectory_max_poses, 0);
+    MBSLAM_CHECK_OPTION_GE(adjusted_trajectory_refine_keyframes, 0);
     MBSLAM_CHECK_OPTION(depth_bound_margin > 0.0 && depth_bound_margin < 1.0);
     MBSLAM_CHECK_OPTION_GT(frustum_bound_factor, 1.0);
     MBSLAM_CHECK_OPTION_GT(metric_min_baseline_m, 0.0);
@@ -231,6 +244,12 @@ struct SlamOptions {
     v("guided_radius_px", &guided_radius_px, "guided search half-window (px)");
     v("guided_min_ncc", &guided_min_ncc, "guided match acceptance (NCC)");
     v("guided_max_points", &guided_max_points, "guided searches per image at most (count)");
+    v("adjusted_trajectory_max_poses", &adjusted_trajectory_max_poses,
+      "images whose trajectory-file pose follows their keyframe's later adjustments, the oldest forgotten "
+      "first (count; 0 = off)");
+    v("adjusted_trajectory_refine_keyframes", &adjusted_trajectory_refine_keyframes,
+      "images tracked since this many newest keyframes are re-resected against the map after each bundle "
+      "adjustment, for the trajectory files (count; 0 = anchoring only)");
     v("map_load_path", &map_load_path, "map loaded at start (\"\" = none)");
     v("map_save_path", &map_save_path, "map saved at exit (\"\" = none)");
   }
@@ -317,6 +336,14 @@ class SlamSystem {
   // Links a re-found map point to the track the tracker created for it.
   void AssociateTrack(int64_t point_id, int64_t track_id) { map_.AssociateTrack(point_id, track_id); }
 
+  // Every posed image this SLAM remembers (utime, cam_from_world), oldest first: its pose
+  // relative to the keyframe it was tracked from (or, for images posed when a map was
+  // confirmed, the nearest keyframe) composed with that keyframe's current pose; images
+  // whose keyframe was culled or whose map was dropped keep the keyframe's last pose.
+  // An image posed twice (a dropped map's, then back-filled by the next) appears once,
+  // with its latest pose. Call Flush() first for the last adjustment to count.
+  std::vector<std::pair<int64_t, Rigid3d>> AdjustedTrajectory() const;
+
   // Waits for the back-end, e.g. before reading the map or at the end of a replay.
   void Flush();
   void Reset();
@@ -396,6 +423,26 @@ class SlamSystem {
   // The current estimate of a recent frame's pose (following its anchor keyframe).
   std::optional<Rigid3d> PoseOf(int64_t frame) const;
   std::map<int64_t, Rigid3d> recent_odometry_;  // frame -> odom_from_cam
+  // The adjusted trajectory (AdjustedTrajectory): per posed image, its pose relative to
+  // an anchor keyframe of the current map (anchor_keyframe >= 0), or resolved into
+  // cam_from_world once that keyframe is gone.
+  struct TrajectoryEntry {
+    int64_t frame = 0;
+    int64_t utime = 0;
+    int64_t anchor_keyframe = -1;
+    Rigid3d cam_from_anchor;
+    Rigid3d cam_from_world;
+  };
+  std::deque<TrajectoryEntry> trajectory_;
+  std::map<int64_t, int64_t> frame_utime_;  // recent and unposed frames -> image time
+  // Tracking inliers (point id, normalised xy) of the images still re-resected.
+  std::map<int64_t, std::vector<std::pair<int64_t, Eigen::Vector2d>>> refine_obs_;
+  // After a bundle adjustment: those images re-resected against the moved map.
+  void RefineTrajectory();
+  // `frame` was posed (cam_from_world in the current map) against keyframe `anchor`.
+  void RecordTrajectory(int64_t frame, const Rigid3d& cam_from_world, const Keyframe* anchor);
+  // Entries anchored on keyframes about to go (culled, or the whole map): resolved.
+  void ResolveTrajectory(bool all_keyframes, int64_t keyframe_id = -1);
   // Every track's normalised position in the recent posed images (the references of the
   // epipolar-assisted pose), and the number of such poses in a row.
   std::map<int64_t, std::unordered_map<int64_t, Eigen::Vector2d>> posed_xy_;
