@@ -9,7 +9,10 @@
 #include <random>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "services/perception/slam/slam_system.h"
+#include "services/perception/tracking/patch_matcher.h"
 
 namespace mbslam {
 namespace {
@@ -163,7 +166,23 @@ struct StarvedRun {
   double worst_error = 0.0;  // camera centre error after image 30, in units of the truth (m)
 };
 
-StarvedRun RunStarved(bool hybrid, int min_tracking_inliers = 20) {
+// The appearance the observations carry (SlamObservation::patch): none, an edge (the
+// patch's structure tensor has one large eigenvalue: it slides along the edge) or a
+// corner (two).
+enum class Patches { kNone, kEdge, kCorner };
+
+cv::Mat MakePatch(Patches kind) {
+  cv::Mat p(11, 11, CV_8U);
+  for (int y = 0; y < p.rows; ++y) {
+    for (int x = 0; x < p.cols; ++x) {
+      const bool right = x >= 5, low = y >= 5;
+      p.at<uint8_t>(y, x) = kind == Patches::kEdge ? (right ? 200 : 60) : ((right != low) ? 200 : 60);
+    }
+  }
+  return p;
+}
+
+StarvedRun RunStarved(bool hybrid, int min_tracking_inliers = 20, Patches patches = Patches::kNone) {
   const Scene scene(7);
   SlamOptions options;
   options.ba.time_limited = false;
@@ -176,8 +195,10 @@ StarvedRun RunStarved(bool hybrid, int min_tracking_inliers = 20) {
   double scale = 0.0;
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0.0, 0.5 / kFocal);
+  const cv::Mat patch = patches == Patches::kNone ? cv::Mat() : MakePatch(patches);
   for (int f = 0; f < 46; ++f) {
     SlamFrame frame = scene.Frame(f);
+    for (SlamObservation& o : frame.observations) o.patch = patch;
     if (f >= 30) {
       for (SlamObservation& o : frame.observations) {
         o.xy += Eigen::Vector2d(noise(rng), noise(rng));  // 0.5 px
@@ -219,6 +240,21 @@ TEST(SlamHybridTracking, PosesGoOnThroughAStarvedMap) {
   // 2.2 cm. The links keep the pose going; with these short-lived tracks they add little
   // accuracy.
   EXPECT_LT(on.worst_error, 0.04);
+}
+
+// Only corner-like tracks are linked (SlamOptions::hybrid_min_corner_ratio): tracks whose
+// patches are edges (they slide along them) give no links, and the map is lost as
+// without assisted poses; corners are linked like tracks without a patch.
+TEST(SlamHybridTracking, EdgeTracksAreNotLinkedCornersAre) {
+  ASSERT_LT(PatchCornerRatio(MakePatch(Patches::kEdge)), 0.1);
+  ASSERT_GT(PatchCornerRatio(MakePatch(Patches::kCorner)), 0.1);
+  const StarvedRun edges = RunStarved(true, 20, Patches::kEdge);
+  const StarvedRun corners = RunStarved(true, 20, Patches::kCorner);
+  EXPECT_EQ(edges.assisted, 0);
+  EXPECT_LT(edges.valid_after_30, 10);
+  EXPECT_EQ(corners.assisted, 11);
+  EXPECT_EQ(corners.unposed_after_30, std::vector<int>({44}));
+  EXPECT_LT(corners.worst_error, 0.04);
 }
 
 }  // namespace
