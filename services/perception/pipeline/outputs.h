@@ -156,8 +156,9 @@ class OutputSink {
   virtual ~OutputSink() = default;
   virtual void OnFrameResult(const FrameResult& result) = 0;
   // Once, after the last image: the camera trajectory as the map finally has it
-  // ((utime, world_from_cam), oldest first; images whose poses the map no longer
-  // refines are absent). What a sink does with it is its own affair.
+  // ((utime, world_from_cam), oldest first; images of a dropped map, or whose keyframe was
+  // culled, with that keyframe's last pose; images beyond the SLAM's bound are absent).
+  // What a sink does with it is its own affair.
   virtual void OnAdjustedCameraTrajectory(const std::vector<std::pair<int64_t, Rigid3d>>& world_from_cam) {
     (void)world_from_cam;
   }

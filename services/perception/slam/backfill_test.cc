@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 #include <map>
 #include <random>
@@ -87,6 +88,47 @@ TEST(SlamBackfill, EarlierImagesGetTheirPosesWhenTheMapIsConfirmed) {
     const Eigen::Vector3d c = T.Inverse().translation / scale;
     EXPECT_NEAR((c - Scene::Center(static_cast<int>(f))).norm(), 0.0, 0.01) << "image " << f;
   }
+}
+
+// A new map must track the next images with most of its points (the 3-view check of sec.
+// 4.4, SlamOptions::init_confirm_frames, init_confirm_inlier_ratio): when most tracks of
+// the image after the initialisation disagree with it (here 60 % jump 6 px), the map is
+// dropped, no pose is given, and a new map is made and confirmed later.
+TEST(SlamBackfill, AMapTheNextImageContradictsIsDropped) {
+  const Scene scene(5);
+  SlamOptions options;
+  options.ba.time_limited = false;
+  options.background_ba = false;
+  SlamSystem slam(options);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI), u01(0.0, 1.0);
+  int made_at = -1, dropped_at = -1, confirmed_after_drop = -1;
+  for (int f = 0; f < 60; ++f) {
+    SlamFrame frame = scene.Frame(f);
+    const bool contradict = made_at >= 0 && f == made_at + 1;
+    if (contradict) {
+      for (SlamObservation& o : frame.observations) {
+        if (u01(rng) > 0.6) continue;
+        const double a = angle(rng);
+        o.xy += 6.0 / kFocal * Eigen::Vector2d(std::cos(a), std::sin(a));
+        o.uv = o.xy * kFocal + Eigen::Vector2d(320.0, 240.0);
+      }
+    }
+    const SlamPose pose = slam.TrackPose(frame);
+    if (made_at < 0 && slam.map().num_keyframes() >= 2) made_at = f;
+    if (contradict) {
+      EXPECT_FALSE(pose.valid);
+      EXPECT_EQ(slam.map().num_keyframes(), 0u) << "the contradicted map is kept";
+      dropped_at = f;
+    }
+    if (dropped_at >= 0 && f > dropped_at && pose.valid && confirmed_after_drop < 0) confirmed_after_drop = f;
+    std::unordered_map<int64_t, int> labels;
+    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
+    slam.UpdateMap(frame, labels);
+  }
+  ASSERT_GE(made_at, 0);
+  EXPECT_EQ(dropped_at, made_at + 1);
+  EXPECT_GT(confirmed_after_drop, dropped_at) << "no new map after the drop";
 }
 
 // The image at which the map was initialised (its second keyframe), or -1; tracks with

@@ -59,7 +59,7 @@ void SlamSystem::Flush() { MergeBundleAdjustment(/*wait=*/true); }
 
 void SlamSystem::Reset() {
   Flush();
-  ResolveTrajectory(/*all_keyframes=*/true);
+  ResolveTrajectory();
   refine_obs_.clear();
   ++map_generation_;
   bridge_.reset();
@@ -94,7 +94,8 @@ Status SlamSystem::SaveMap(const std::string& path) {
 
 Status SlamSystem::LoadMap(const std::string& path) {
   Flush();
-  ResolveTrajectory(/*all_keyframes=*/true);
+  ResolveTrajectory();  // the loaded map's keyframe and point ids start again
+  refine_obs_.clear();
   MBSLAM_RETURN_IF_ERROR(map_.Load(path));
   // A loaded map is only trusted after the camera relocalises against it; without
   // descriptors that means re-initialising, so it serves as a prior for display.
@@ -112,7 +113,6 @@ void SlamSystem::StorePose(int64_t frame, const Rigid3d& T, const Matrix6d& cova
   }
   recent_poses_[frame] = p;
   while (recent_poses_.size() > 64) recent_poses_.erase(recent_poses_.begin());
-  RecordTrajectory(frame, T, map_.LastKeyframe());
 }
 
 void SlamSystem::RecordTrajectory(int64_t frame, const Rigid3d& T, const Keyframe* anchor) {
@@ -128,15 +128,29 @@ void SlamSystem::RecordTrajectory(int64_t frame, const Rigid3d& T, const Keyfram
     e.cam_from_anchor = T * anchor->cam_from_world.Inverse();
   }
   trajectory_.push_back(e);
-  while (static_cast<int>(trajectory_.size()) > options_.adjusted_trajectory_max_poses) trajectory_.pop_front();
+  if (static_cast<int>(trajectory_.size()) > options_.adjusted_trajectory_max_poses) {
+    while (static_cast<int>(trajectory_.size()) > options_.adjusted_trajectory_max_poses) trajectory_.pop_front();
+    // Culled keyframes older than the oldest entry's anchor are no longer needed (an entry
+    // whose anchor is gone falls back to its pose as tracked).
+    const int64_t oldest = trajectory_.front().anchor_keyframe;
+    if (oldest >= 0) retired_keyframes_.erase(retired_keyframes_.begin(), retired_keyframes_.lower_bound(oldest));
+  }
 }
 
-void SlamSystem::ResolveTrajectory(bool all_keyframes, int64_t keyframe_id) {
+const Rigid3d* SlamSystem::AnchorPose(int64_t keyframe_id) const {
+  if (keyframe_id < 0) return nullptr;
+  if (const Keyframe* kf = map_.keyframe(keyframe_id)) return &kf->cam_from_world;
+  auto r = retired_keyframes_.find(keyframe_id);
+  return r != retired_keyframes_.end() ? &r->second : nullptr;
+}
+
+void SlamSystem::ResolveTrajectory() {
   for (TrajectoryEntry& e : trajectory_) {
-    if (e.anchor_keyframe < 0 || (!all_keyframes && e.anchor_keyframe != keyframe_id)) continue;
-    if (const Keyframe* kf = map_.keyframe(e.anchor_keyframe)) e.cam_from_world = e.cam_from_anchor * kf->cam_from_world;
+    if (e.anchor_keyframe < 0) continue;
+    if (const Rigid3d* K = AnchorPose(e.anchor_keyframe)) e.cam_from_world = e.cam_from_anchor * *K;
     e.anchor_keyframe = -1;
   }
+  retired_keyframes_.clear();
 }
 
 void SlamSystem::RefineTrajectory() {
@@ -178,8 +192,8 @@ void SlamSystem::RefineTrajectory() {
 std::vector<std::pair<int64_t, Rigid3d>> SlamSystem::AdjustedTrajectory() const {
   std::map<int64_t, Rigid3d> by_utime;
   for (const TrajectoryEntry& e : trajectory_) {
-    const Keyframe* kf = e.anchor_keyframe >= 0 ? map_.keyframe(e.anchor_keyframe) : nullptr;
-    by_utime[e.utime] = kf ? e.cam_from_anchor * kf->cam_from_world : e.cam_from_world;
+    const Rigid3d* K = AnchorPose(e.anchor_keyframe);
+    by_utime[e.utime] = K ? e.cam_from_anchor * *K : e.cam_from_world;
   }
   return {by_utime.begin(), by_utime.end()};
 }
@@ -293,7 +307,8 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   if (state_ == SlamState::kNotInitialized || state_ == SlamState::kInitializing) {
     TryInitialize(frame, &out);
     last_frame_ = frame.frame_index;
-    if (out.valid) {
+    if (out.valid) {  // a map without confirmation: this image's pose is published
+      RecordTrajectory(frame.frame_index, out.cam_from_world, map_.LastKeyframe());
       BackfillPoses(frame.frame_index, &out);
     } else {
       RememberUnposed(frame);
@@ -373,7 +388,10 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     out.num_refound = 0;
     out.epipolar_assisted = assisted;
     StorePose(frame.frame_index, est.cam_from_world, est.covariance);
-    if (options_.adjusted_trajectory_refine_keyframes > 0 && options_.adjusted_trajectory_max_poses > 0) {
+    // Published poses only: a confirming map's images are back-filled once it is
+    // confirmed (or never, if it is dropped).
+    if (out.valid) RecordTrajectory(frame.frame_index, est.cam_from_world, map_.LastKeyframe());
+    if (out.valid && options_.adjusted_trajectory_refine_keyframes > 0 && options_.adjusted_trajectory_max_poses > 0) {
       auto& obs = refine_obs_[frame.frame_index];
       obs.clear();
       for (size_t i = 0; i < tracks.size(); ++i) {
@@ -1115,6 +1133,7 @@ std::optional<double> SlamSystem::EstablishMetricScale() {
     e.cam_from_world.translation *= s;
     e.cam_from_anchor.translation *= s;
   }
+  for (auto& [id, K] : retired_keyframes_) K.translation *= s;
   for (auto& [frame, pose] : recent_poses_) {
     pose.cam_from_world.translation *= s;
     pose.cam_from_anchor.translation *= s;
@@ -1145,7 +1164,7 @@ int SlamSystem::CullKeyframes(int64_t frame_index) {
         ++removed;
       }
     }
-    ResolveTrajectory(/*all_keyframes=*/false, id);
+    if (options_.adjusted_trajectory_max_poses > 0) retired_keyframes_[id] = oldest->second.cam_from_world;
     map_.keyframes().erase(id);
     if (was_fixed && !map_.keyframes().empty()) map_.keyframes().begin()->second.fixed = true;
   }

@@ -55,7 +55,11 @@ struct SlamOptions {
   int init_max_motions = 3;              // motions told apart in the two views (sequential RANSAC) (count)
   double init_min_coverage = 0.3;        // the static world's inliers, and its points with parallax, must hold this share of the image's feature cells
   double init_max_hull_share = 0.5;      // an initialisation with more of its inliers inside moving hulls is refused
-  int init_confirm_frames = 3;           // frames the new map must track well before it is trusted (frames)
+  // The 3-view check of sec. 4.4: the views after the initial two must agree with the new
+  // map. One view, as the thesis: no evaluated sequence ever dropped a map on the second
+  // or third (and the live poses wait for the confirmation: TartanAir, five starts, 90.5 %
+  // of the images with 3 views, 91.7 % with 1, the trajectories identical).
+  int init_confirm_frames = 1;           // frames the new map must track well before it is trusted (frames)
   // A map from a short baseline has poorly known depths and biases the poses tracked on
   // it until the next keyframes re-triangulate. An initialisation that passes every test
   // but has less than init_good_parallax_deg of median parallax waits for more (the
@@ -118,7 +122,7 @@ struct SlamOptions {
   // tracked from, composed with that keyframe's final (bundle-adjusted) pose
   // (AdjustedTrajectory): an image's live pose cannot follow the corrections that later
   // adjustments make to its keyframe. This many images at most, the oldest forgotten
-  // first (they keep their live poses in the files) (count; 0 = off).
+  // first (they keep their live poses in the files) (count, about 160 bytes each; 0 = off).
   int adjusted_trajectory_max_poses = 1 << 18;
   // Images tracked since the last keyframes are also re-resected (motion-only, on their
   // tracking inliers) against the map each time a bundle adjustment has moved it, while
@@ -336,12 +340,12 @@ class SlamSystem {
   // Links a re-found map point to the track the tracker created for it.
   void AssociateTrack(int64_t point_id, int64_t track_id) { map_.AssociateTrack(point_id, track_id); }
 
-  // Every posed image this SLAM remembers (utime, cam_from_world), oldest first: its pose
-  // relative to the keyframe it was tracked from (or, for images posed when a map was
-  // confirmed, the nearest keyframe) composed with that keyframe's current pose; images
-  // whose keyframe was culled or whose map was dropped keep the keyframe's last pose.
-  // An image posed twice (a dropped map's, then back-filled by the next) appears once,
-  // with its latest pose. Call Flush() first for the last adjustment to count.
+  // Every image this SLAM published a pose for (live or back-filled) and still remembers
+  // (utime, cam_from_world), oldest first: its pose relative to the keyframe it was
+  // tracked from (or, for back-filled images, the nearest keyframe) composed with that
+  // keyframe's current pose; images whose keyframe was culled or whose map was dropped
+  // keep the keyframe's last pose. An image recorded twice (time going backwards) appears
+  // once, with its latest pose. Call Flush() first for the last adjustment to count.
   std::vector<std::pair<int64_t, Rigid3d>> AdjustedTrajectory() const;
 
   // Waits for the back-end, e.g. before reading the map or at the end of a replay.
@@ -441,8 +445,12 @@ class SlamSystem {
   void RefineTrajectory();
   // `frame` was posed (cam_from_world in the current map) against keyframe `anchor`.
   void RecordTrajectory(int64_t frame, const Rigid3d& cam_from_world, const Keyframe* anchor);
-  // Entries anchored on keyframes about to go (culled, or the whole map): resolved.
-  void ResolveTrajectory(bool all_keyframes, int64_t keyframe_id = -1);
+  // Culled keyframes' last poses (id -> cam_from_world), for the entries anchored on them.
+  std::map<int64_t, Rigid3d> retired_keyframes_;
+  // A keyframe's current or last pose, nullptr if unknown.
+  const Rigid3d* AnchorPose(int64_t keyframe_id) const;
+  // Before the map is dropped: every entry resolved into cam_from_world.
+  void ResolveTrajectory();
   // Every track's normalised position in the recent posed images (the references of the
   // epipolar-assisted pose), and the number of such poses in a row.
   std::map<int64_t, std::unordered_map<int64_t, Eigen::Vector2d>> posed_xy_;
