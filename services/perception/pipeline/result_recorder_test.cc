@@ -4,12 +4,40 @@
 #include <unistd.h>
 
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "common/util/atomic_file.h"
 
 namespace mbslam {
 namespace {
+
+// Image i (at 1 s + i * 0.1 s) with a camera pose in `state`, its x = i.
+FrameResult ImageResult(int i, TrackingState state) {
+  FrameResult r;
+  r.utime = 1000000 + i * 100000;
+  r.camera_pose.utime = r.utime;
+  r.camera_pose.tracking_state = state;
+  r.camera_pose.world_from_cam.translation.x() = i;
+  return r;
+}
+
+// The x of every pose of a TUM file, in order.
+std::vector<double> TrajectoryX(const std::string& path) {
+  std::string text;
+  EXPECT_TRUE(ReadFileToString(path, &text).ok()) << path;
+  std::istringstream in(text);
+  std::string line;
+  std::vector<double> x;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double t, tx;
+    fields >> t >> tx;
+    x.push_back(tx);
+  }
+  return x;
+}
 
 TEST(ResultRecorder, TumLineFormat) {
   Rigid3d pose(Eigen::Quaterniond(1, 0, 0, 0), Eigen::Vector3d(1.5, -2, 3));
@@ -20,11 +48,7 @@ TEST(ResultRecorder, TumLineFormat) {
 TEST(ResultRecorder, WritesTrackedPosesAndSummary) {
   ResultRecorder recorder;
   for (int i = 0; i < 4; ++i) {
-    FrameResult r;
-    r.utime = 1000000 + i * 100000;
-    r.camera_pose.utime = r.utime;
-    r.camera_pose.tracking_state = i == 0 ? TrackingState::kInitializing : TrackingState::kOk;
-    r.camera_pose.world_from_cam.translation.x() = i;
+    FrameResult r = ImageResult(i, i == 0 ? TrackingState::kInitializing : TrackingState::kOk);
     recorder.OnFrameResult(r);
   }
   char pattern[] = "/tmp/mbslam_rec_XXXXXX";
@@ -44,11 +68,7 @@ TEST(ResultRecorder, BackfilledPosesGoInTimeOrder) {
   ResultRecorder recorder;
   // Images 0-3 without a pose; image 4 confirms a map and brings poses for 0-3 (1 lost).
   for (int i = 0; i < 6; ++i) {
-    FrameResult r;
-    r.utime = 1000000 + i * 100000;
-    r.camera_pose.utime = r.utime;
-    r.camera_pose.tracking_state = i < 4 ? TrackingState::kInitializing : TrackingState::kOk;
-    r.camera_pose.world_from_cam.translation.x() = i;
+    FrameResult r = ImageResult(i, i < 4 ? TrackingState::kInitializing : TrackingState::kOk);
     if (i == 4) {
       for (int k : {0, 2, 3}) {
         Rigid3d p;
@@ -64,20 +84,9 @@ TEST(ResultRecorder, BackfilledPosesGoInTimeOrder) {
   char pattern[] = "/tmp/mbslam_rec_XXXXXX";
   const std::string dir = mkdtemp(pattern);
   ASSERT_TRUE(recorder.Write(dir, "").ok());
-  std::string traj, summary;
-  ASSERT_TRUE(ReadFileToString(dir + "/camera_trajectory.tum", &traj).ok());
+  std::string summary;
   ASSERT_TRUE(ReadFileToString(dir + "/summary.json", &summary).ok());
-  std::istringstream in(traj);
-  std::string line;
-  std::vector<double> x;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    double t, tx;
-    fields >> t >> tx;
-    x.push_back(tx);
-  }
-  EXPECT_EQ(x, (std::vector<double>{0, 2, 3, 4, 5}));
+  EXPECT_EQ(TrajectoryX(dir + "/camera_trajectory.tum"), (std::vector<double>{0, 2, 3, 4, 5}));
   EXPECT_NE(summary.find("\"tracked_fraction\": 0.333"), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"frames_backfilled\": 3"), std::string::npos) << summary;
 }
@@ -88,11 +97,7 @@ TEST(ResultRecorder, BackfilledPosesGoInTimeOrder) {
 TEST(ResultRecorder, AdjustedPosesReplaceLiveOnesOfTheSameImages) {
   ResultRecorder recorder;
   for (int i = 0; i < 5; ++i) {
-    FrameResult r;
-    r.utime = 1000000 + i * 100000;
-    r.camera_pose.utime = r.utime;
-    r.camera_pose.tracking_state = i == 1 ? TrackingState::kLost : TrackingState::kOk;
-    r.camera_pose.world_from_cam.translation.x() = i;
+    FrameResult r = ImageResult(i, i == 1 ? TrackingState::kLost : TrackingState::kOk);
     recorder.OnFrameResult(r);
   }
   std::vector<std::pair<int64_t, Rigid3d>> adjusted;
@@ -105,23 +110,8 @@ TEST(ResultRecorder, AdjustedPosesReplaceLiveOnesOfTheSameImages) {
   char pattern[] = "/tmp/mbslam_rec_XXXXXX";
   const std::string dir = mkdtemp(pattern);
   ASSERT_TRUE(recorder.Write(dir, "").ok());
-  auto xs = [&](const std::string& file) {
-    std::string text;
-    EXPECT_TRUE(ReadFileToString(dir + "/" + file, &text).ok()) << file;
-    std::istringstream in(text);
-    std::string line;
-    std::vector<double> x;
-    while (std::getline(in, line)) {
-      if (line.empty() || line[0] == '#') continue;
-      std::istringstream fields(line);
-      double t, tx;
-      fields >> t >> tx;
-      x.push_back(tx);
-    }
-    return x;
-  };
-  EXPECT_EQ(xs("camera_trajectory.tum"), (std::vector<double>{0, 12, 3, 14}));
-  EXPECT_EQ(xs("camera_trajectory_live.tum"), (std::vector<double>{0, 2, 3, 4}));
+  EXPECT_EQ(TrajectoryX(dir + "/camera_trajectory.tum"), (std::vector<double>{0, 12, 3, 14}));
+  EXPECT_EQ(TrajectoryX(dir + "/camera_trajectory_live.tum"), (std::vector<double>{0, 2, 3, 4}));
   std::string summary;
   ASSERT_TRUE(ReadFileToString(dir + "/summary.json", &summary).ok());
   EXPECT_NE(summary.find("\"frames_adjusted\": 2"), std::string::npos) << summary;
@@ -131,11 +121,7 @@ TEST(ResultRecorder, AdjustedPosesReplaceLiveOnesOfTheSameImages) {
 TEST(ResultRecorder, TrajectoriesAreBoundedOldestDropped) {
   ResultRecorder recorder(/*max_poses=*/10);
   for (int i = 0; i < 25; ++i) {
-    FrameResult r;
-    r.utime = 1000000 + i * 100000;
-    r.camera_pose.utime = r.utime;
-    r.camera_pose.tracking_state = TrackingState::kOk;
-    r.camera_pose.world_from_cam.translation.x() = i;
+    FrameResult r = ImageResult(i, TrackingState::kOk);
     ObjectOutput o;
     o.id = 1 + i / 5;  // five poses per object
     o.state = ObjectState::kTracked;
@@ -167,10 +153,7 @@ TEST(ResultRecorder, ReportsWhatItKeeps) {
   EXPECT_EQ(recorder.RetainedBytes(), 0);
   // Image i: a reconstruction of object 1 + i / 10 with 500 points, and a camera pose.
   auto image = [](int i, bool tracked) {
-    FrameResult r;
-    r.utime = 1000000 + i * 100000;
-    r.camera_pose.utime = r.utime;
-    r.camera_pose.tracking_state = tracked ? TrackingState::kOk : TrackingState::kLost;
+    FrameResult r = ImageResult(i, tracked ? TrackingState::kOk : TrackingState::kLost);
     ObjectReconstructionOutput rec;
     rec.object_id = 1 + i / 10;
     rec.map_id = rec.object_id;
