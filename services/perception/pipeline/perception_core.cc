@@ -503,7 +503,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
                       << ", backward " << ts.lost_backward << ", forward-backward " << ts.lost_consistency
                       << ", border " << ts.lost_border << ", appearance " << ts.lost_appearance << "; established "
                       << ts.established_matched << " of " << ts.established << " kept), created "
-                      << ts.created << ", ORB re-found " << ts.descriptor_matched << ", median flow "
+                      << ts.created << " (" << ts.created_on_objects << " on moving objects), ORB re-found " << ts.descriptor_matched << ", median flow "
                       << ts.median_flow_px << " px" << (ts.fast_motion ? " (fast-motion KLT)" : "");
   }
   if (tracker_.stats().exposure_corrected) {

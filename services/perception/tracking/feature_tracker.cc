@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <unordered_map>
 
@@ -572,6 +573,8 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   prev_pyramid_ = *tracked_pyramid;
   prev_klt_pyramid_ = std::move(klt_pyramid);
   DetectNew(image, frame_index);
+  stats_.created_on_objects = DetectOnObjects(image, frame_index, hints.occluders);
+  stats_.created += stats_.created_on_objects;
 }
 
 int FeatureTracker::GuidedMatch(const std::unordered_map<int64_t, Eigen::Vector2f>& predicted_uv) {
@@ -843,7 +846,15 @@ void FeatureTracker::EnforceUnicity() {
 
 void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
   const int cells = options_.grid_cols * options_.grid_rows;
-  const int room = options_.max_features - static_cast<int>(tracks_.size());
+  // Tracks added on moving objects (object_features) are above max_features and take
+  // no cell's share, until the segmentation puts them in the static world (a false
+  // detection, or an object that stopped): from then on they are ordinary tracks.
+  int on_objects = 0;
+  for (Track& t : tracks_) {
+    if (t.body_id == 0) t.on_object = false;
+    on_objects += t.on_object;
+  }
+  const int room = options_.max_features - (static_cast<int>(tracks_.size()) - on_objects);
   if (room <= 0) return;
   const int per_cell = std::max(1, (options_.max_features + cells - 1) / cells);
   const float cell_w = static_cast<float>(image.cols) / options_.grid_cols;
@@ -865,7 +876,7 @@ void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
   std::vector<int> count(static_cast<size_t>(cells), 0);
   for (const Track& t : tracks_) {
     disc_.Stamp(&mask, cv::Point(static_cast<int>(std::lround(t.uv.x())), static_cast<int>(std::lround(t.uv.y()))), 0);
-    ++count[static_cast<size_t>(cell_of(t.uv.x(), t.uv.y()))];
+    if (!t.on_object) ++count[static_cast<size_t>(cell_of(t.uv.x(), t.uv.y()))];
   }
 
   // FAST only where features are wanted: over each run of neighbouring cells of a grid
@@ -960,6 +971,105 @@ void FeatureTracker::DetectNew(const cv::Mat& image, int64_t frame_index) {
     }
   }
   stats_.created = created;
+}
+
+int FeatureTracker::DetectOnObjects(const cv::Mat& image, int64_t frame_index,
+                                    const std::vector<TrackingHints::Hull>& hulls) {
+  if (options_.object_features <= 0 || hulls.empty()) return 0;
+  int budget = options_.object_extra_features;
+  for (const Track& t : tracks_) budget -= t.on_object;
+  if (budget <= 0) return 0;
+  const int b = options_.border_px + 3;  // the border DetectNew leaves
+  if (image.cols <= 2 * b || image.rows <= 2 * b) return 0;
+  const cv::Rect usable(b, b, image.cols - 2 * b, image.rows - 2 * b);
+  const float min_d = static_cast<float>(options_.object_min_distance_px);
+  const float margin = static_cast<float>(options_.object_hull_margin_px);
+  // Distance from p to the hull's boundary (p inside).
+  auto boundary_distance = [](const std::vector<Eigen::Vector2f>& hull, const Eigen::Vector2f& p) {
+    float best = std::numeric_limits<float>::infinity();
+    for (size_t i = 0; i < hull.size(); ++i) {
+      const Eigen::Vector2f a = hull[i], e = hull[(i + 1) % hull.size()] - a;
+      const float len2 = e.squaredNorm();
+      const float s = len2 > 0.0f ? std::clamp((p - a).dot(e) / len2, 0.0f, 1.0f) : 0.0f;
+      best = std::min(best, (a + s * e - p).norm());
+    }
+    return best;
+  };
+  int created = 0;
+  for (const TrackingHints::Hull& h : hulls) {
+    if (budget <= 0) break;
+    if (h.points.size() < 3) continue;
+    Eigen::Vector2f lo = h.points[0], hi = h.points[0];
+    bool finite = true;
+    for (const Eigen::Vector2f& p : h.points) {
+      finite = finite && p.allFinite();
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    if (!finite) continue;
+    double area2 = 0.0;  // twice the hull's area (shoelace)
+    for (size_t i = 0; i < h.points.size(); ++i) {
+      const Eigen::Vector2f& a = h.points[i];
+      const Eigen::Vector2f& c = h.points[(i + 1) % h.points.size()];
+      area2 += static_cast<double>(a.x()) * c.y() - static_cast<double>(c.x()) * a.y();
+    }
+    if (0.5 * std::abs(area2) > options_.object_max_hull_share * image.total()) continue;
+    const cv::Rect box = cv::Rect(cv::Point(static_cast<int>(std::floor(lo.x())), static_cast<int>(std::floor(lo.y()))),
+                                  cv::Point(static_cast<int>(std::ceil(hi.x())) + 1, static_cast<int>(std::ceil(hi.y())) + 1)) &
+                         usable;
+    if (box.width < 8 || box.height < 8) continue;
+    // The tracks in and around the hull: how many it holds, and the spacing of new ones.
+    std::vector<Eigen::Vector2f> near;
+    int inside = 0;
+    for (const Track& t : tracks_) {
+      if (t.uv.x() < box.x - min_d || t.uv.y() < box.y - min_d || t.uv.x() > box.x + box.width + min_d ||
+          t.uv.y() > box.y + box.height + min_d) {
+        continue;
+      }
+      near.push_back(t.uv);
+      inside += t.active() && InsideConvexHull(h.points, t.uv);
+    }
+    int want = std::min(options_.object_features - inside, budget);
+    if (want <= 0) continue;
+    // Shi-Tomasi corners (what KLT tracks well) inside the hull, best first.
+    cv::Mat hull_mask(box.size(), CV_8UC1, cv::Scalar(0));
+    std::vector<cv::Point> polygon;
+    for (const Eigen::Vector2f& p : h.points) {
+      polygon.emplace_back(static_cast<int>(std::lround(p.x())) - box.x, static_cast<int>(std::lround(p.y())) - box.y);
+    }
+    cv::fillConvexPoly(hull_mask, polygon, cv::Scalar(255));
+    std::vector<cv::Point2f> corners;
+    cv::goodFeaturesToTrack(image(box), corners, 3 * want + static_cast<int>(near.size()), /*qualityLevel=*/0.01,
+                            options_.object_min_distance_px, hull_mask);
+    for (const cv::Point2f& c : corners) {
+      if (want <= 0) break;
+      const Eigen::Vector2f p(c.x + static_cast<float>(box.x), c.y + static_cast<float>(box.y));
+      if (!InsideConvexHull(h.points, p) || boundary_distance(h.points, p) < margin) continue;
+      bool free = true;
+      for (const Eigen::Vector2f& q : near) {
+        if ((q - p).squaredNorm() < min_d * min_d) {
+          free = false;
+          break;
+        }
+      }
+      if (!free) continue;
+      Track t;
+      t.id = next_id_++;
+      t.uv = p;
+      t.first_frame = frame_index;
+      t.last_seen_frame = frame_index;
+      t.is_new = true;
+      t.on_object = true;
+      if (!ExtractPatch(image, t.uv, options_.patch_size, &t.patch)) continue;
+      t.anchor = t.patch;
+      near.push_back(p);
+      tracks_.push_back(std::move(t));
+      --want;
+      --budget;
+      ++created;
+    }
+  }
+  return created;
 }
 
 }  // namespace mbslam

@@ -99,6 +99,16 @@ struct TrackerOptions {
   bool exposure_compensation = true;
   double exposure_min_mean_change = 5.0;      // mean grey level change that triggers it (grey levels)
   double exposure_min_contrast_change = 0.05; // ... or relative change of the standard deviation (fraction)
+  // Denser features on moving objects (TrackingHints::occluders, the moving hulls): a
+  // small object gets as many tracks as a grid cell allows the background, too few for
+  // its motion model and its own reconstruction. Inside each hull, new features are
+  // added more closely spaced until it holds object_features tracks, above
+  // max_features by at most object_extra_features in all.
+  int object_features = 0;             // tracks wanted inside each moving hull (count; 0 = off)
+  int object_extra_features = 200;     // tracks these may add above max_features in all (count)
+  double object_min_distance_px = 4.0; // spacing of the features added there (px)
+  double object_hull_margin_px = 3.0;  // ... at least this far inside the hull, off its boundary (px)
+  double object_max_hull_share = 0.05; // ... only in hulls smaller than this share of the image (fraction)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(max_features, 0);
@@ -146,6 +156,11 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION_GE(glitch_min_tracks, 1);
     MBSLAM_CHECK_OPTION_GE(exposure_min_mean_change, 0.0);
     MBSLAM_CHECK_OPTION_GE(exposure_min_contrast_change, 0.0);
+    MBSLAM_CHECK_OPTION_GE(object_features, 0);
+    MBSLAM_CHECK_OPTION_GE(object_extra_features, 0);
+    MBSLAM_CHECK_OPTION_GE(object_min_distance_px, 1.0);
+    MBSLAM_CHECK_OPTION_GE(object_hull_margin_px, 0.0);
+    MBSLAM_CHECK_OPTION(object_max_hull_share > 0.0 && object_max_hull_share <= 1.0);
     return true;
   }
   template <typename V>
@@ -203,6 +218,12 @@ struct TrackerOptions {
     v("exposure_min_mean_change", &exposure_min_mean_change, "mean change that triggers the compensation (grey levels)");
     v("exposure_min_contrast_change", &exposure_min_contrast_change,
       "relative contrast change that triggers the compensation (fraction)");
+    v("object_features", &object_features,
+      "tracks wanted inside each moving object's hull: new ones added there more densely (count; 0 = off)");
+    v("object_extra_features", &object_extra_features, "tracks those may add above max_features in all (count)");
+    v("object_min_distance_px", &object_min_distance_px, "spacing of the features added inside moving hulls (px)");
+    v("object_hull_margin_px", &object_hull_margin_px, "... at least this far inside the hull (px)");
+    v("object_max_hull_share", &object_max_hull_share, "... only in hulls smaller than this share of the image (fraction)");
   }
 };
 
@@ -245,6 +266,7 @@ struct TrackerStats {
   int occluded = 0;       // kept behind hulls
   int recovered = 0;      // re-found by guided matching
   int created = 0;        // new features
+  int created_on_objects = 0;  // of which added inside moving hulls (object_features)
   int rejected_unicity = 0;
   int descriptor_matched = 0;  // recovered by the ORB fallback
   bool fast_motion = false;    // KLT ran with the fast-motion settings
@@ -295,6 +317,8 @@ class FeatureTracker {
 
  private:
   void DetectNew(const cv::Mat& image, int64_t frame_index);
+  // Adds features inside the moving hulls (object_features); returns how many.
+  int DetectOnObjects(const cv::Mat& image, int64_t frame_index, const std::vector<TrackingHints::Hull>& hulls);
   void EnforceUnicity();
   std::unordered_map<int64_t, size_t> IndexById() const;  // track id -> index in tracks_
   // Wide-baseline fallback: lost tracks re-matched by ORB descriptors.

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -105,6 +106,85 @@ TEST(FeatureTracker, OccludedTracksAreKeptAndRecovered) {
     }
   }
   EXPECT_GE(recovered, static_cast<int>(0.8 * inside.size()));
+}
+
+TEST(FeatureTracker, MovingHullsGetDenserFeaturesAboveTheLimit) {
+  // Two moving objects: a narrow one (30 x 90 px, a person 9 m away), which the grid
+  // gives about as many features as the background around it, and a larger one the grid
+  // already covers with more than object_features.
+  const std::vector<Eigen::Vector2f> narrow = {{300, 200}, {330, 200}, {330, 290}, {300, 290}};
+  const std::vector<Eigen::Vector2f> wide = {{60, 60}, {220, 60}, {220, 160}, {60, 160}};
+  TrackingHints hints;
+  hints.occluders.push_back({3, narrow});
+  hints.occluders.push_back({4, wide});
+  const cv::Mat base = Texture(640, 480, 11);
+  auto run = [&](const TrackerOptions& o) {
+    auto tracker = std::make_unique<FeatureTracker>(o);
+    tracker->TrackFrame(Pyramid(base), 0, {});
+    tracker->TrackFrame(Pyramid(base), 1, hints);
+    return tracker;
+  };
+  auto inside = [](const FeatureTracker& t, const std::vector<Eigen::Vector2f>& hull) {
+    int n = 0;
+    for (const Track& tr : t.tracks()) n += InsideConvexHull(hull, tr.uv);
+    return n;
+  };
+  const auto plain = run(TrackerOptions{});
+  const int plain_narrow = inside(*plain, narrow), plain_wide = inside(*plain, wide);
+  EXPECT_LT(plain_narrow, 20);
+  EXPECT_GT(plain_wide, 40);
+  EXPECT_EQ(plain->stats().created_on_objects, 0);
+
+  TrackerOptions o;
+  o.object_features = 40;
+  o.object_max_hull_share = 1.0;  // any hull (the wide one is 5.2 % of the image)
+  const auto dense = run(o);
+  const FeatureTracker& t = *dense;
+  EXPECT_EQ(inside(t, narrow), 40);
+  EXPECT_EQ(inside(t, wide), plain_wide) << "already holds more than object_features";
+  int on_objects = 0;
+  for (const Track& tr : t.tracks()) {
+    if (!tr.on_object) continue;
+    ++on_objects;
+    ASSERT_TRUE(InsideConvexHull(narrow, tr.uv));
+    const float to_edge = std::min({tr.uv.x() - narrow[0].x(), narrow[1].x() - tr.uv.x(), tr.uv.y() - narrow[0].y(),
+                                    narrow[2].y() - tr.uv.y()});
+    EXPECT_GE(to_edge, o.object_hull_margin_px);
+    for (const Track& other : t.tracks()) {
+      if (other.id == tr.id) continue;
+      ASSERT_GE((other.uv - tr.uv).norm(), o.object_min_distance_px);
+    }
+  }
+  EXPECT_EQ(on_objects, 40 - plain_narrow);
+  EXPECT_EQ(t.stats().created_on_objects, on_objects);
+  // The background keeps its share: the tracks not added on objects are those without.
+  EXPECT_EQ(static_cast<int>(t.tracks().size()) - on_objects, static_cast<int>(plain->tracks().size()));
+  // The next image: the object's tracks are kept and none is added.
+  dense->TrackFrame(Pyramid(base), 2, hints);
+  EXPECT_EQ(dense->stats().created_on_objects, 0);
+  EXPECT_EQ(inside(*dense, narrow), 40);
+  // Once the segmentation puts them in the static world they are ordinary tracks: with
+  // them the tracks are above max_features, so no new one is detected until some are lost.
+  for (Track& tr : dense->tracks()) tr.body_id = 0;
+  dense->TrackFrame(Pyramid(base), 3, {});
+  for (const Track& tr : dense->tracks()) EXPECT_FALSE(tr.on_object);
+  EXPECT_GT(dense->tracks().size(), static_cast<size_t>(o.max_features));
+  EXPECT_EQ(dense->stats().created, 0);
+
+  // The budget above max_features bounds them, whatever the hulls want.
+  o.object_extra_features = 10;
+  const auto bounded = run(o);
+  EXPECT_EQ(bounded->stats().created_on_objects, 10);
+  EXPECT_EQ(inside(*bounded, narrow), plain_narrow + 10);
+
+  // Hulls larger than object_max_hull_share of the image get none, however few tracks
+  // they hold (the narrow one is 0.9 % of the image, the wide one 5.2 %).
+  TrackerOptions many;
+  many.object_features = 150;
+  many.object_max_hull_share = 0.04;
+  const auto shared = run(many);
+  EXPECT_EQ(inside(*shared, wide), plain_wide);
+  EXPECT_GT(inside(*shared, narrow), 40);
 }
 
 TEST(FeatureTracker, InconsistentMatchesAreDropped) {

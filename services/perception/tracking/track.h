@@ -39,6 +39,7 @@ struct Track {
   float p_static = 0.5f;           // P(static w.r.t. the static world)
   bool has_3d = false;             // has a map point in its body's map
   bool is_new = true;              // created in the latest image
+  bool on_object = false;          // added inside a moving hull, above max_features (object_features), until labelled static
 
   bool active() const { return status == TrackStatus::kActive; }
 };
