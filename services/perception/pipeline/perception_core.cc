@@ -840,6 +840,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     segments_of[oid].push_back(&o);
     TrackingHints::Hull occ;
     occ.body_id = o.id;
+    occ.age_frames = static_cast<int>(std::max<int64_t>(0, frame_index_ - o.first_frame));
     for (const Eigen::Vector2d& p : o.hull) occ.points.push_back((p + o.mean_flow_px).cast<float>());
     if (occ.points.size() >= 3) occluders_.push_back(std::move(occ));
   }

@@ -998,7 +998,7 @@ int FeatureTracker::DetectOnObjects(const cv::Mat& image, int64_t frame_index,
   int created = 0;
   for (const TrackingHints::Hull& h : hulls) {
     if (budget <= 0) break;
-    if (h.points.size() < 3) continue;
+    if (h.points.size() < 3 || h.age_frames < options_.object_min_age_frames) continue;
     Eigen::Vector2f lo = h.points[0], hi = h.points[0];
     bool finite = true;
     for (const Eigen::Vector2f& p : h.points) {

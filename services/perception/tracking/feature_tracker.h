@@ -109,6 +109,7 @@ struct TrackerOptions {
   double object_min_distance_px = 4.0; // spacing of the features added there (px)
   double object_hull_margin_px = 3.0;  // ... at least this far inside the hull, off its boundary (px)
   double object_max_hull_share = 0.05; // ... only in hulls smaller than this share of the image (fraction)
+  int object_min_age_frames = 0;       // ... only of objects segmented for at least this many images (frames)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(max_features, 0);
@@ -161,6 +162,7 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION_GE(object_min_distance_px, 1.0);
     MBSLAM_CHECK_OPTION_GE(object_hull_margin_px, 0.0);
     MBSLAM_CHECK_OPTION(object_max_hull_share > 0.0 && object_max_hull_share <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(object_min_age_frames, 0);
     return true;
   }
   template <typename V>
@@ -224,6 +226,7 @@ struct TrackerOptions {
     v("object_min_distance_px", &object_min_distance_px, "spacing of the features added inside moving hulls (px)");
     v("object_hull_margin_px", &object_hull_margin_px, "... at least this far inside the hull (px)");
     v("object_max_hull_share", &object_max_hull_share, "... only in hulls smaller than this share of the image (fraction)");
+    v("object_min_age_frames", &object_min_age_frames, "... only of objects segmented for at least this many images (frames)");
   }
 };
 
@@ -236,6 +239,7 @@ struct TrackingHints {
   struct Hull {
     int body_id = 0;
     std::vector<Eigen::Vector2f> points;
+    int age_frames = 0;  // images since the object was first segmented
   };
   std::vector<Hull> occluders;
 };

@@ -185,6 +185,14 @@ TEST(FeatureTracker, MovingHullsGetDenserFeaturesAboveTheLimit) {
   const auto shared = run(many);
   EXPECT_EQ(inside(*shared, wide), plain_wide);
   EXPECT_GT(inside(*shared, narrow), 40);
+
+  // Nor do objects younger than object_min_age_frames (the hulls here are 2 images old).
+  hints.occluders[0].age_frames = hints.occluders[1].age_frames = 2;
+  o.object_extra_features = 200;
+  o.object_min_age_frames = 3;
+  EXPECT_EQ(run(o)->stats().created_on_objects, 0);
+  o.object_min_age_frames = 2;
+  EXPECT_EQ(run(o)->stats().created_on_objects, 40 - plain_narrow);
 }
 
 TEST(FeatureTracker, InconsistentMatchesAreDropped) {
