@@ -64,6 +64,10 @@ double MotionSegmenter::BayesUpdate(double prior, double likelihood, double para
   return std::clamp(p, 1.0 - options_.p_clamp, options_.p_clamp);
 }
 
+int MotionSegmenter::BaseHistory() const {
+  return std::max(options_.history_frames, options_.multibody_init ? options_.multibody_max_frames : 0);
+}
+
 void MotionSegmenter::UpdateHistories(const SegmenterInput& in) {
   const double prior_r2 = std::pow(options_.neighbour_prior_radius * in.width, 2);
   std::vector<const TrackState*> established;
@@ -72,28 +76,70 @@ void MotionSegmenter::UpdateHistories(const SegmenterInput& in) {
     auto it = tracks_.find(o.id);
     if (it != tracks_.end() && it->second.frames.size() >= 2) established.push_back(&it->second);
   }
+  // Hulls of the confirmed moving objects, from their members' positions in this image.
+  struct ObjectHull {
+    int id = 0;
+    std::vector<Eigen::Vector2f> hull;
+    double p_static = 0.0;  // members' mean
+  };
+  std::vector<ObjectHull> hulls;
+  if (options_.object_hull_prior) {
+    std::map<int, std::pair<std::vector<Eigen::Vector2f>, double>> members;
+    for (const TrackObservation& o : in.observations) {
+      auto it = tracks_.find(o.id);
+      if (it == tracks_.end() || !it->second.moving || it->second.object <= 0) continue;
+      auto obj = objects_.find(it->second.object);
+      if (obj == objects_.end() || !obj->second.confirmed ||
+          in.frame_index - obj->second.first_frame < options_.object_hull_prior_min_age_frames) {
+        continue;
+      }
+      auto& m = members[it->second.object];
+      m.first.push_back(o.uv.cast<float>());
+      m.second += it->second.p_static;
+    }
+    for (auto& [id, m] : members) {
+      if (static_cast<int>(m.first.size()) < options_.min_object_tracks) continue;
+      const double p = m.second / static_cast<double>(m.first.size());
+      Eigen::Vector2f centroid = Eigen::Vector2f::Zero();
+      for (const Eigen::Vector2f& q : m.first) centroid += q;
+      centroid /= static_cast<float>(m.first.size());
+      std::vector<Eigen::Vector2f> hull = ConvexHull(std::move(m.first));
+      const float shrink = static_cast<float>(options_.object_hull_prior_shrink);
+      for (Eigen::Vector2f& q : hull) q = centroid + shrink * (q - centroid);
+      hulls.push_back(ObjectHull{id, std::move(hull), p});
+    }
+  }
   for (const TrackObservation& o : in.observations) {
     auto [it, inserted] = tracks_.try_emplace(o.id);
     TrackState& t = it->second;
     if (inserted) {
       t.id = o.id;
-      // Prior from established neighbours: features appear on movers too.
-      double sum = 0.0;
-      int count = 0;
-      for (const TrackState* n : established) {
-        if ((n->uv.back() - o.uv).squaredNorm() <= prior_r2) {
-          sum += n->p_static;
-          ++count;
+      const Eigen::Vector2f uv = o.uv.cast<float>();
+      const auto hull = std::find_if(hulls.begin(), hulls.end(),
+                                     [&](const ObjectHull& h) { return InsideConvexHull(h.hull, uv); });
+      if (hull != hulls.end()) {
+        t.p_static = std::clamp(0.5 + 0.8 * (hull->p_static - 0.5), 0.05, 0.95);
+        t.moving = t.p_static < options_.static_leave;
+        if (t.moving) t.object = hull->id;
+      } else {
+        // Prior from established neighbours: features appear on movers too.
+        double sum = 0.0;
+        int count = 0;
+        for (const TrackState* n : established) {
+          if ((n->uv.back() - o.uv).squaredNorm() <= prior_r2) {
+            sum += n->p_static;
+            ++count;
+          }
         }
+        if (count >= 3) t.p_static = std::clamp(0.5 + 0.8 * (sum / count - 0.5), 0.05, 0.95);
+        t.moving = t.p_static < options_.static_leave;
       }
-      if (count >= 3) t.p_static = std::clamp(0.5 + 0.8 * (sum / count - 0.5), 0.05, 0.95);
-      t.moving = t.p_static < options_.static_leave;
     }
     t.frames.push_back(in.frame_index);
     t.xy.push_back(o.xy);
     t.uv.push_back(o.uv);
     t.last_frame = in.frame_index;
-    const int keep = std::max(options_.history_frames, options_.multibody_init ? options_.multibody_max_frames : 0);
+    const int keep = std::max(BaseHistory(), options_.long_baseline_frames + 1);
     while (static_cast<int>(t.frames.size()) > keep) {
       t.frames.erase(t.frames.begin());
       t.xy.erase(t.xy.begin());
@@ -176,6 +222,88 @@ int MotionSegmenter::UpdateStaticProbabilities(const SegmenterInput& in, int64_t
     else if (!t.moving && t.p_static < options_.static_leave) t.moving = true;
   }
   return ground ? ground->inliers : 0;
+}
+
+int MotionSegmenter::UpdateLongBaseline(const SegmenterInput& in, int64_t ref) {
+  if (options_.long_baseline_frames <= 0 || !options_.likelihood.use_fvb || !in.world_motion) return 0;
+  const int64_t n = in.frame_index;
+  const double lag = static_cast<double>(std::max<int64_t>(1, n - ref));
+  // Candidate references, oldest first, each at least min_ratio times the image's lag back.
+  std::vector<int64_t> refs;
+  for (int64_t r = std::max(first_frame_, n - options_.long_baseline_frames);
+       static_cast<double>(n - r) >= options_.long_baseline_min_ratio * lag; r += options_.long_baseline_step) {
+    refs.push_back(r);
+  }
+  if (refs.empty()) return 0;
+  struct Judged {
+    TrackState* t;
+    double p_fvb;
+  };
+  struct Pair {
+    bool tried = false;
+    std::optional<RelativeMotion> motion;
+    std::vector<MotionSample> samples;
+    std::vector<Judged> judged;
+    int failed = 0;  // judged tracks whose flow breaks the bound (epipolar test passed)
+  };
+  std::map<int64_t, Pair> pairs;
+  StaticLikelihoodOptions likelihood = options_.likelihood;
+  for (const TrackObservation& o : in.observations) {
+    TrackState& t = tracks_.at(o.id);
+    if (t.moving) continue;
+    // The oldest candidate the track was observed in.
+    int64_t r = -1;
+    Eigen::Vector2d x_r;
+    for (int64_t c : refs) {
+      if (t.At(c, &x_r)) {
+        r = c;
+        break;
+      }
+    }
+    if (r < 0) continue;
+    Pair& pair = pairs[r];
+    if (!pair.tried) {
+      pair.tried = true;
+      // Only a motion with a known scale (SLAM, odometry): the bound needs depths in its units.
+      std::optional<RelativeMotion> m = in.world_motion(r, n);
+      if (m && m->translation_known && m->scale_known) {
+        pair.samples = MotionSigmaPoints(*m);
+        pair.motion = std::move(m);
+      }
+    }
+    if (!pair.motion) continue;
+    likelihood.envelope_combine = options_.likelihood.envelope_combine == "max_odometry"
+                                      ? (pair.motion->source == RelativeMotion::Source::kOdometry ? "max" : "mean")
+                                      : options_.likelihood.envelope_combine;
+    const DepthBound depth = in.depth_bound ? in.depth_bound(o.id, x_r, r) : DepthBound();
+    const StaticLikelihood lik = ComputeStaticLikelihood(x_r, o.xy, pair.samples, true, true, depth, in.focal_px,
+                                                         likelihood);
+    // The degenerate case only: the epipolar constraint holds and the flow breaks the bound.
+    if (lik.alpha > 0.5) continue;
+    pair.judged.push_back(Judged{&t, lik.p_fvb});
+    pair.failed += lik.p_fvb < 0.5;
+  }
+  int judged = 0;
+  for (auto& [r, pair] : pairs) {
+    // A degenerate mover is a minority of the tracks believed static: when many of them
+    // break the bound at once, the long motion or its depth bounds are wrong (drift,
+    // approximate intrinsics), not the world.
+    if (pair.judged.size() < static_cast<size_t>(options_.world_min_tracks) ||
+        pair.failed > options_.long_baseline_max_fail_share * static_cast<double>(pair.judged.size())) {
+      continue;
+    }
+    judged += static_cast<int>(pair.judged.size());
+    const double e = options_.likelihood_tail;
+    for (const Judged& j : pair.judged) {
+      if (j.p_fvb >= 0.5) continue;
+      TrackState& t = *j.t;
+      const double log_lr = std::log((j.p_fvb + e) / (1.0 - j.p_fvb + e)) * options_.long_baseline_weight;
+      const double odds = t.p_static / (1.0 - t.p_static) * std::exp(log_lr);
+      t.p_static = std::clamp(odds / (1.0 + odds), 1.0 - options_.p_clamp, options_.p_clamp);
+      if (t.p_static < options_.static_leave) t.moving = true;
+    }
+  }
+  return judged;
 }
 
 void MotionSegmenter::UpdateObjectModels(const SegmenterInput& in, int64_t ref) {
@@ -287,7 +415,8 @@ void MotionSegmenter::ClusterUnexplained(const SegmenterInput& in, int64_t ref) 
       // ...and a pair distance that changes slowly over the shared history.
       double sum = 0.0, sum2 = 0.0;
       int count = 0;
-      for (size_t k = 0; k < a.t->frames.size(); ++k) {
+      const size_t kept = a.t->frames.size();
+      for (size_t k = kept - std::min(kept, static_cast<size_t>(BaseHistory())); k < kept; ++k) {
         Eigen::Vector2d uv_b;
         if (!b.t->At(a.t->frames[k], nullptr, &uv_b)) continue;
         const double d = (a.t->uv[k] - uv_b).norm();
@@ -599,6 +728,7 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
         }
       }
     }
+    result.long_baseline_tracks = UpdateLongBaseline(in, ref);
     UpdateObjectModels(in, ref);
     ClusterUnexplained(in, ref);
   }

@@ -58,6 +58,13 @@ struct SegmentationOptions {
   double static_enter = 0.6;        // P(static) to become static again
   double static_leave = 0.4;        // P(static) below which a track is moving
   double neighbour_prior_radius = 0.06;  // new tracks take their prior from neighbours within this (fraction of width)
+  // A new track inside the convex hull of a confirmed moving object's members (as
+  // observed in this image) takes its prior from those members and joins the object,
+  // instead of averaging over every neighbour (the background around a small object
+  // outnumbers it); its own evidence then confirms or releases it.
+  bool object_hull_prior = false;
+  int object_hull_prior_min_age_frames = 10; // ... only objects segmented for at least this many images (frames)
+  double object_hull_prior_shrink = 0.7;     // ... the hull scaled about its members' centroid by this (fraction)
   int min_object_tracks = 6;        // tracks needed for an object (count)
   int confirm_frames = 2;           // a cluster must persist this long to become an object (frames)
   int object_timeout_frames = 15;   // an object unseen this long is removed (frames)
@@ -83,6 +90,21 @@ struct SegmentationOptions {
   // history_frames) are tried this many times for one whose translation is measurable
   // (a pure rotation would make every near static point's parallax look like motion).
   int translation_lag_tries = 2;
+  // Long-baseline Flow Vector Bound. A mover that keeps inside its epipolar plane (a
+  // robot followed along the camera's own direction) looks like a static point farther
+  // away; its flow falls short of the least flow the depth bound allows by an amount
+  // that grows with the baseline, but over the usual reference lag that shortfall stays
+  // within the bound's noise margin. Tracks believed static are therefore also judged
+  // against an image up to long_baseline_frames back, with the world motion and depth
+  // bounds of SLAM or odometry (scale known; never a two-view estimate): where the
+  // epipolar test passes and the flow breaks the bound there, the evidence counts
+  // against static. Only evidence against: the short pairs already count the static
+  // evidence of the same observations.
+  int long_baseline_frames = 48;         // oldest reference (frames back); 0 = off
+  int long_baseline_step = 8;            // references tried every this many images (frames)
+  double long_baseline_min_ratio = 2.0;  // used only this many times farther back than the image's reference (ratio)
+  double long_baseline_weight = 0.5;     // exponent on the long pair's likelihood ratio
+  double long_baseline_max_fail_share = 0.1;  // a pair whose flow bound fails for more of its static tracks is not used (fraction)
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(likelihood);
@@ -111,6 +133,13 @@ struct SegmentationOptions {
     MBSLAM_CHECK_OPTION_GT(cluster_radius, 0.0);
     MBSLAM_CHECK_OPTION_GE(min_model_tracks, 8);
     MBSLAM_CHECK_OPTION_GE(world_min_tracks, 8);
+    MBSLAM_CHECK_OPTION_GE(object_hull_prior_min_age_frames, 0);
+    MBSLAM_CHECK_OPTION(object_hull_prior_shrink > 0.0 && object_hull_prior_shrink <= 1.0);
+    MBSLAM_CHECK_OPTION(long_baseline_frames >= 0 && long_baseline_frames <= 120);
+    MBSLAM_CHECK_OPTION_GE(long_baseline_step, 1);
+    MBSLAM_CHECK_OPTION_GE(long_baseline_min_ratio, 1.0);
+    MBSLAM_CHECK_OPTION(long_baseline_weight > 0.0 && long_baseline_weight <= 1.0);
+    MBSLAM_CHECK_OPTION(long_baseline_max_fail_share >= 0.0 && long_baseline_max_fail_share <= 1.0);
     return true;
   }
   template <typename V>
@@ -140,6 +169,12 @@ struct SegmentationOptions {
     v("static_enter", &static_enter, "P(static) to become static");
     v("static_leave", &static_leave, "P(static) below which a track is moving");
     v("neighbour_prior_radius", &neighbour_prior_radius, "prior radius for new tracks (fraction of width)");
+    v("object_hull_prior", &object_hull_prior,
+      "new tracks inside a confirmed moving object's hull take its members' prior and join it");
+    v("object_hull_prior_shrink", &object_hull_prior_shrink,
+      "... the hull scaled about its members' centroid by this (fraction)");
+    v("object_hull_prior_min_age_frames", &object_hull_prior_min_age_frames,
+      "... only objects segmented for at least this many images (frames)");
     v("min_object_tracks", &min_object_tracks, "tracks needed for an object (count)");
     v("confirm_frames", &confirm_frames, "frames a cluster must persist (frames)");
     v("object_timeout_frames", &object_timeout_frames, "unseen objects removed after (frames)");
@@ -155,6 +190,13 @@ struct SegmentationOptions {
       "a pure-rotation reference motion: references 2x, 4x ... as far back tried this often for a measurable translation (count)");
     v("young_heading_from_reference", &young_heading_from_reference,
       "a pure-rotation image-to-image motion takes the reference motion's translation direction for the young tracks");
+    v("long_baseline_frames", &long_baseline_frames,
+      "static tracks also judged by the flow bound against an image this far back, with SLAM / odometry motion (frames; 0 = off)");
+    v("long_baseline_step", &long_baseline_step, "... references tried every this many images (frames)");
+    v("long_baseline_min_ratio", &long_baseline_min_ratio, "... only this many times farther back than the image's reference (ratio)");
+    v("long_baseline_weight", &long_baseline_weight, "... exponent on the long pair's likelihood ratio");
+    v("long_baseline_max_fail_share", &long_baseline_max_fail_share,
+      "... a pair whose bound fails for more of its static tracks is not used (fraction)");
   }
 };
 
@@ -205,6 +247,7 @@ struct SegmentationResult {
   std::optional<RelativeMotion> world_motion;  // used for this image (ref -> current)
   int64_t world_ref_frame = -1;
   int pair_ground_inliers = 0;       // tracks on the pair's ground plane (0: none found / used)
+  int long_baseline_tracks = 0;      // tracks judged by the long-baseline flow bound
   Eigen::Vector3d epipole = Eigen::Vector3d::Zero();  // homogeneous, px
   bool initialized = false;          // the static world has been identified
 };
@@ -249,7 +292,12 @@ class MotionSegmenter {
   std::optional<RelativeMotion> WorldMotion(const SegmenterInput& input, int64_t ref);
   // Returns the tracks on the pair's ground plane (0 if none was found or used).
   int UpdateStaticProbabilities(const SegmenterInput& input, int64_t ref, const RelativeMotion& motion);
+  // The long-baseline flow bound (options long_baseline_*); returns the tracks judged.
+  int UpdateLongBaseline(const SegmenterInput& input, int64_t ref);
   void UpdateObjectModels(const SegmenterInput& input, int64_t ref);
+  // Observations kept per track for the usual reference search and clustering (the
+  // long baseline may keep more).
+  int BaseHistory() const;
   void ClusterUnexplained(const SegmenterInput& input, int64_t ref);
   // `parallax_px`: how much the pair could tell; static evidence from pairs with little
   // parallax is discounted (they cannot reveal a degenerate mover yet).
