@@ -174,16 +174,28 @@ void SlamSystem::RefineTrajectory() {
     if (!kf || kf->frame_index == e->frame) continue;  // a keyframe's image is the keyframe
     std::vector<Eigen::Vector3d> X;
     std::vector<Eigen::Vector2d> xy;
-    for (const auto& [pid, x] : o->second) {
+    for (const auto& [pid, x] : o->second.inliers) {
       const MapPoint* p = map_.point(pid);
       if (!p) continue;
       X.push_back(p->position);
       xy.push_back(x);
     }
     if (static_cast<int>(X.size()) < options_.min_tracking_inliers) continue;
+    const Rigid3d T0 = e->cam_from_anchor * kf->cam_from_world;
+    // Tracks triangulated since: gated on the image's current pose (a track that was
+    // static then and has a point now is most likely static, but a wrong point must not
+    // pull the pose).
+    const double gate = options_.adjusted_trajectory_later_points_px / focal_px_;
+    for (const auto& [track, x] : o->second.later) {
+      const int64_t pid = map_.PointOfTrack(track);
+      const MapPoint* p = pid >= 0 ? map_.point(pid) : nullptr;
+      if (!p || ReprojectionError(T0, p->position, x) > gate) continue;
+      X.push_back(p->position);
+      xy.push_back(x);
+    }
     const std::vector<uint8_t> use(X.size(), 1);
-    const Rigid3d T = RefinePose(e->cam_from_anchor * kf->cam_from_world, X, xy, use, focal_px_,
-                                 options_.pose.huber_px, options_.pose.refine_iterations, nullptr);
+    const Rigid3d T = RefinePose(T0, X, xy, use, focal_px_, options_.pose.huber_px,
+                                 options_.pose.refine_iterations, nullptr);
     if (!T.translation.allFinite() || !T.rotation.coeffs().allFinite()) continue;
     e->cam_from_anchor = T * kf->cam_from_world.Inverse();
   }
@@ -392,12 +404,18 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     // confirmed (or never, if it is dropped).
     if (out.valid) RecordTrajectory(frame.frame_index, est.cam_from_world, map_.LastKeyframe());
     if (out.valid && options_.adjusted_trajectory_refine_keyframes > 0 && options_.adjusted_trajectory_max_poses > 0) {
-      auto& obs = refine_obs_[frame.frame_index];
-      obs.clear();
+      RefineObservations& obs = refine_obs_[frame.frame_index];
+      obs.inliers.clear();
+      obs.later.clear();
       for (size_t i = 0; i < tracks.size(); ++i) {
         if (i >= est.inliers.size() || !est.inliers[i]) continue;
         const int64_t pid = tracks[i] >= 0 ? map_.PointOfTrack(tracks[i]) : refound_ids[static_cast<size_t>(-1 - tracks[i])];
-        if (pid >= 0) obs.emplace_back(pid, xy[i]);
+        if (pid >= 0) obs.inliers.emplace_back(pid, xy[i]);
+      }
+      if (options_.adjusted_trajectory_later_points_px > 0.0) {
+        for (const SlamObservation& so : frame.observations) {
+          if (so.body_id == 0 && map_.PointOfTrack(so.track_id) < 0) obs.later.emplace_back(so.track_id, so.xy);
+        }
       }
       while (refine_obs_.size() > 256) refine_obs_.erase(refine_obs_.begin());
     }

@@ -128,7 +128,12 @@ struct SlamOptions {
   // tracking inliers) against the map each time a bundle adjustment has moved it, while
   // their keyframe is one of this many newest: a keyframe's adjustment corrects its
   // points, which the images tracked on them do not see otherwise (0 = anchoring only).
-  int adjusted_trajectory_refine_keyframes = 2;
+  int adjusted_trajectory_refine_keyframes = 3;
+  // ... and on the static tracks they saw that had no map point then but have one now
+  // (triangulated at a later keyframe), when it reprojects within this of the image's
+  // pose: between two keyframes the map holds only the points of the older one, and
+  // the tracks born since carry the newer part of the view (px; 0 = tracking inliers only).
+  double adjusted_trajectory_later_points_px = 2.0;
   std::string map_load_path;             // map loaded at start ("" = none)
   std::string map_save_path;             // map saved at exit ("" = none)
   // Images that carry a rotation prior (SlamFrame::rotation_prior) constrain the rotation
@@ -179,6 +184,7 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION_GE(culled_point_max_unmatched_frames, 1);
     MBSLAM_CHECK_OPTION_GE(adjusted_trajectory_max_poses, 0);
     MBSLAM_CHECK_OPTION_GE(adjusted_trajectory_refine_keyframes, 0);
+    MBSLAM_CHECK_OPTION_GE(adjusted_trajectory_later_points_px, 0.0);
     MBSLAM_CHECK_OPTION(depth_bound_margin > 0.0 && depth_bound_margin < 1.0);
     MBSLAM_CHECK_OPTION_GT(frustum_bound_factor, 1.0);
     MBSLAM_CHECK_OPTION_GT(metric_min_baseline_m, 0.0);
@@ -254,6 +260,9 @@ struct SlamOptions {
     v("adjusted_trajectory_refine_keyframes", &adjusted_trajectory_refine_keyframes,
       "images tracked since this many newest keyframes are re-resected against the map after each bundle "
       "adjustment, for the trajectory files (count; 0 = anchoring only)");
+    v("adjusted_trajectory_later_points_px", &adjusted_trajectory_later_points_px,
+      "re-resection also on the image's static tracks triangulated later, within this reprojection error "
+      "(px; 0 = tracking inliers only)");
     v("map_load_path", &map_load_path, "map loaded at start (\"\" = none)");
     v("map_save_path", &map_save_path, "map saved at exit (\"\" = none)");
   }
@@ -439,8 +448,13 @@ class SlamSystem {
   };
   std::deque<TrajectoryEntry> trajectory_;
   std::map<int64_t, int64_t> frame_utime_;  // recent and unposed frames -> image time
-  // Tracking inliers (point id, normalised xy) of the images still re-resected.
-  std::map<int64_t, std::vector<std::pair<int64_t, Eigen::Vector2d>>> refine_obs_;
+  // What the images still re-resected saw: their tracking inliers (point id, normalised
+  // xy) and their static tracks without a map point then (track id, normalised xy).
+  struct RefineObservations {
+    std::vector<std::pair<int64_t, Eigen::Vector2d>> inliers;
+    std::vector<std::pair<int64_t, Eigen::Vector2d>> later;
+  };
+  std::map<int64_t, RefineObservations> refine_obs_;
   // After a bundle adjustment: those images re-resected against the moved map.
   void RefineTrajectory();
   // `frame` was posed (cam_from_world in the current map) against keyframe `anchor`.
