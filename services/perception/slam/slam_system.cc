@@ -189,10 +189,16 @@ void SlamSystem::RefineTrajectory() {
     for (const auto& [track, x] : o->second.later) {
       const int64_t pid = map_.PointOfTrack(track);
       const MapPoint* p = pid >= 0 ? map_.point(pid) : nullptr;
-      if (!p || ReprojectionError(T0, p->position, x) > gate) continue;
+      if (!p) continue;
+      if (ReprojectionError(T0, p->position, x) > gate) {
+        ++refine_stats_.later_gated;
+        continue;
+      }
       X.push_back(p->position);
       xy.push_back(x);
+      ++refine_stats_.later_used;
     }
+    ++refine_stats_.images;
     const std::vector<uint8_t> use(X.size(), 1);
     const Rigid3d T = RefinePose(T0, X, xy, use, focal_px_, options_.pose.huber_px,
                                  options_.pose.refine_iterations, nullptr);

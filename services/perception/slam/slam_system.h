@@ -370,6 +370,14 @@ class SlamSystem {
   // poses changes with it.
   int64_t map_generation() const { return map_generation_; }
   int64_t ba_runs() const { return ba_runs_; }
+  // The trajectory files' re-resections so far: images re-resected, and the points their
+  // static tracks got later that were used or left out by the reprojection gate.
+  struct RefineStats {
+    int64_t images = 0;
+    int64_t later_used = 0;
+    int64_t later_gated = 0;
+  };
+  const RefineStats& refine_stats() const { return refine_stats_; }
   double last_ba_seconds() const { return last_ba_seconds_; }
 
   Status SaveMap(const std::string& path);
@@ -455,6 +463,7 @@ class SlamSystem {
     std::vector<std::pair<int64_t, Eigen::Vector2d>> later;
   };
   std::map<int64_t, RefineObservations> refine_obs_;
+  RefineStats refine_stats_;
   // After a bundle adjustment: those images re-resected against the moved map.
   void RefineTrajectory();
   // `frame` was posed (cam_from_world in the current map) against keyframe `anchor`.
