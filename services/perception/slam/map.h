@@ -46,6 +46,7 @@ struct MapPoint {
   int times_visible = 0;            // frames it was predicted in view
   int times_found = 0;              // frames it was matched
   bool occluded = false;            // behind a moving object (sec. 4.3): kept, not matched
+  int64_t released_frame = -1;      // image at which its last track was released (moving, or drifted off it); -1 = never
   uint8_t gray = 128;               // intensity at creation (for display)
   cv::Mat patch;                    // appearance at the last observation (guided matching)
 };

@@ -177,6 +177,15 @@ void SlamSystem::RefineTrajectory() {
     for (const auto& [pid, x] : o->second.inliers) {
       const MapPoint* p = map_.point(pid);
       if (!p) continue;
+      // A point whose track was released after this image (the segmentation stopped
+      // calling it static, or the track drifted off it) was seen here through that
+      // track: on sim-multi these are mostly the walkers' tracks a keyframe triangulated
+      // while they still looked static, which pulled the images after it by up to 12 mm.
+      // Sightings after the release (re-found by guided matching) are kept.
+      if (options_.adjusted_trajectory_skip_released && p->released_frame >= e->frame) {
+        ++refine_stats_.released_skipped;
+        continue;
+      }
       X.push_back(p->position);
       xy.push_back(x);
     }
@@ -450,6 +459,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
         p->occluded = false;
         if (!patches[i].empty()) p->patch = patches[i];
       } else {
+        p->released_frame = frame.frame_index;
         map_.ReleaseTrack(tracks[i]);  // the track drifted off its point
       }
     }
@@ -1215,6 +1225,7 @@ SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered
       update.released_tracks.push_back(o.track_id);
       map_.RemovePoint(pid);
     } else {
+      map_.point(pid)->released_frame = frame.frame_index;
       map_.ReleaseTrack(o.track_id);
     }
   }

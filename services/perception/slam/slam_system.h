@@ -134,6 +134,10 @@ struct SlamOptions {
   // pose: between two keyframes the map holds only the points of the older one, and
   // the tracks born since carry the newer part of the view (px; 0 = tracking inliers only).
   double adjusted_trajectory_later_points_px = 2.0;
+  // ... and without the tracking inliers seen through a track that was released from its
+  // point afterwards (the segmentation stopped calling it static: the point is released,
+  // not removed, sec. 4.3; or the track drifted off the point).
+  bool adjusted_trajectory_skip_released = true;
   std::string map_load_path;             // map loaded at start ("" = none)
   std::string map_save_path;             // map saved at exit ("" = none)
   // Images that carry a rotation prior (SlamFrame::rotation_prior) constrain the rotation
@@ -263,6 +267,9 @@ struct SlamOptions {
     v("adjusted_trajectory_later_points_px", &adjusted_trajectory_later_points_px,
       "re-resection also on the image's static tracks triangulated later, within this reprojection error "
       "(px; 0 = tracking inliers only)");
+    v("adjusted_trajectory_skip_released", &adjusted_trajectory_skip_released,
+      "re-resection leaves out the tracking inliers seen through a track released from its point "
+      "afterwards (no longer static, or drifted off it)");
     v("map_load_path", &map_load_path, "map loaded at start (\"\" = none)");
     v("map_save_path", &map_save_path, "map saved at exit (\"\" = none)");
   }
@@ -370,12 +377,14 @@ class SlamSystem {
   // poses changes with it.
   int64_t map_generation() const { return map_generation_; }
   int64_t ba_runs() const { return ba_runs_; }
-  // The trajectory files' re-resections so far: images re-resected, and the points their
-  // static tracks got later that were used or left out by the reprojection gate.
+  // The trajectory files' re-resections so far: images re-resected, the points their
+  // static tracks got later that were used or left out by the reprojection gate, and the
+  // tracking inliers left out because their track was released from its point afterwards.
   struct RefineStats {
     int64_t images = 0;
     int64_t later_used = 0;
     int64_t later_gated = 0;
+    int64_t released_skipped = 0;
   };
   const RefineStats& refine_stats() const { return refine_stats_; }
   double last_ba_seconds() const { return last_ba_seconds_; }
@@ -457,7 +466,8 @@ class SlamSystem {
   std::deque<TrajectoryEntry> trajectory_;
   std::map<int64_t, int64_t> frame_utime_;  // recent and unposed frames -> image time
   // What the images still re-resected saw: their tracking inliers (point id, normalised
-  // xy) and their static tracks without a map point then (track id, normalised xy).
+  // xy; those seen through a track released from its point later are left out) and their static
+  // tracks without a map point then (track id, normalised xy).
   struct RefineObservations {
     std::vector<std::pair<int64_t, Eigen::Vector2d>> inliers;
     std::vector<std::pair<int64_t, Eigen::Vector2d>> later;
