@@ -466,8 +466,8 @@ class SlamSystem {
   std::deque<TrajectoryEntry> trajectory_;
   std::map<int64_t, int64_t> frame_utime_;  // recent and unposed frames -> image time
   // What the images still re-resected saw: their tracking inliers (point id, normalised
-  // xy; those seen through a track released from its point later are left out) and their static
-  // tracks without a map point then (track id, normalised xy).
+  // xy; those seen through a track released from its point later are left out) and
+  // their static tracks without a map point then (track id, normalised xy).
   struct RefineObservations {
     std::vector<std::pair<int64_t, Eigen::Vector2d>> inliers;
     std::vector<std::pair<int64_t, Eigen::Vector2d>> later;
