@@ -348,10 +348,16 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   std::vector<Eigen::Vector2d> xy;
   std::vector<int64_t> tracks;
   std::vector<cv::Mat> patches;
+  // Static tracks without a point (track id, normalised xy): a later keyframe may give
+  // them one, which the trajectory files' re-resection of this image then uses.
+  std::vector<std::pair<int64_t, Eigen::Vector2d>> unmapped_static;
   for (const SlamObservation& o : frame.observations) {
     if (o.body_id != 0) continue;  // only tracks segmentation holds static
     const int64_t pid = map_.PointOfTrack(o.track_id);
-    if (pid < 0) continue;
+    if (pid < 0) {
+      unmapped_static.emplace_back(o.track_id, o.xy);
+      continue;
+    }
     const MapPoint* p = map_.point(pid);
     X.push_back(p->position);
     xy.push_back(o.xy);
@@ -421,17 +427,13 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     if (out.valid && options_.adjusted_trajectory_refine_keyframes > 0 && options_.adjusted_trajectory_max_poses > 0) {
       RefineObservations& obs = refine_obs_[frame.frame_index];
       obs.inliers.clear();
-      obs.later.clear();
       for (size_t i = 0; i < tracks.size(); ++i) {
         if (i >= est.inliers.size() || !est.inliers[i]) continue;
         const int64_t pid = tracks[i] >= 0 ? map_.PointOfTrack(tracks[i]) : refound_ids[static_cast<size_t>(-1 - tracks[i])];
         if (pid >= 0) obs.inliers.emplace_back(pid, xy[i]);
       }
-      if (options_.adjusted_trajectory_later_points_px > 0.0) {
-        for (const SlamObservation& so : frame.observations) {
-          if (so.body_id == 0 && map_.PointOfTrack(so.track_id) < 0) obs.later.emplace_back(so.track_id, so.xy);
-        }
-      }
+      obs.later.clear();
+      if (options_.adjusted_trajectory_later_points_px > 0.0) obs.later = std::move(unmapped_static);
       while (refine_obs_.size() > 256) refine_obs_.erase(refine_obs_.begin());
     }
     if (options_.hybrid_tracking) {
