@@ -24,6 +24,20 @@ namespace {
 constexpr double kFocal = 500.0;
 constexpr int kImages = 120;
 
+// What a run changes in the scene.
+struct SceneVariant {
+  int odometry_from = -1;        // odometry from this image on (-1: none)
+  bool loss = false;             // images 60-65 without observations (the map is lost and re-made), new tracks after
+  bool outliers = false;         // every tenth track 6 px off in every third image, still called static
+  bool moving_outliers = false;  // ... those off sightings called moving (body 1) instead
+  bool released = false;         // every tenth track called static for its first 10 images, then unexplained (-1)
+  SceneVariant& OdometryFrom(int f) { odometry_from = f; return *this; }
+  SceneVariant& Loss() { loss = true; return *this; }
+  SceneVariant& Outliers() { outliers = true; return *this; }
+  SceneVariant& MovingOutliers() { outliers = moving_outliers = true; return *this; }
+  SceneVariant& Released() { released = true; return *this; }
+};
+
 // The camera walks forward and sideways past a field of points 3-12 m deep, turning
 // slowly; each point is tracked over a window of 8-30 images (new tracks every image, so
 // keyframes triangulate and bundle adjustment moves the map), with 0.7 px of noise.
@@ -45,20 +59,13 @@ struct Scene {
     return Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY())),
                    Eigen::Vector3d(0.05 * f, 0.01 * std::sin(0.1 * f), 0.03 * f));
   }
-  // With `loss`, images 60-65 have no observations (the map is lost and re-made) and
-  // the tracks after them are new. With `outliers`, every tenth track is seen 6 px off
-  // in every third image (a bad match the segmentation still calls static). With
-  // `released`, every tenth track is called static for its first 10 images, then
-  // unexplained (-1): its point is released. With `moving_outliers` as well as
-  // `outliers`, the segmentation calls those off sightings moving (body 1).
-  SlamFrame Frame(int f, bool with_odometry = false, bool loss = false, bool outliers = false,
-                  bool released = false, bool moving_outliers = false) const {
+  SlamFrame Frame(int f, const SceneVariant& v = SceneVariant()) const {
     SlamFrame frame;
     frame.frame_index = f;
     frame.utime = 1000000 + int64_t{f} * 33333;
     frame.focal_px = kFocal;
-    if (with_odometry) frame.odom_from_cam = WorldFromCam(f);
-    if (loss && f >= 60 && f < 66) return frame;
+    if (v.odometry_from >= 0 && f >= v.odometry_from) frame.odom_from_cam = WorldFromCam(f);
+    if (v.loss && f >= 60 && f < 66) return frame;
     const Rigid3d cam_from_world = WorldFromCam(f).Inverse();
     for (size_t i = 0; i < points.size(); ++i) {
       if (f < born[i] || f >= dies[i]) continue;
@@ -70,13 +77,13 @@ struct Scene {
       std::mt19937 noise(static_cast<unsigned>(i * 7919 + static_cast<size_t>(f) * 104729));
       std::normal_distribution<double> n(0.0, 0.7 / kFocal);
       xy += Eigen::Vector2d(n(noise), n(noise));
-      const bool off = outliers && i % 10 == 0 && f % 3 == 1;
+      const bool off = v.outliers && i % 10 == 0 && f % 3 == 1;
       if (off) xy.x() += 6.0 / kFocal;
       SlamObservation o;
-      o.track_id = static_cast<int64_t>(i) + (loss && f >= 66 ? 100000 : 0);
+      o.track_id = static_cast<int64_t>(i) + (v.loss && f >= 66 ? 100000 : 0);
       o.xy = xy;
       o.uv = xy * kFocal + Eigen::Vector2d(320.0, 240.0);
-      o.body_id = released && i % 10 == 0 && f >= born[i] + 10 ? -1 : (off && moving_outliers ? 1 : 0);
+      o.body_id = v.released && i % 10 == 0 && f >= born[i] + 10 ? -1 : (off && v.moving_outliers ? 1 : 0);
       o.p_static = o.body_id == 0 ? 0.9 : 0.1;
       frame.observations.push_back(o);
     }
@@ -107,14 +114,12 @@ struct SceneRun {
   SlamSystem::RefineStats refine;
 };
 
-SceneRun RunScene(const SlamOptions& options, int odometry_from = -1, bool loss = false, bool outliers = false,
-                  bool released = false, bool moving_outliers = false) {
+SceneRun RunScene(const SlamOptions& options, const SceneVariant& variant = SceneVariant()) {
   const Scene scene(5);
   SlamSystem slam(options);
   SceneRun run;
   for (int f = 0; f < kImages; ++f) {
-    const SlamFrame frame =
-        scene.Frame(f, odometry_from >= 0 && f >= odometry_from, loss, outliers, released, moving_outliers);
+    const SlamFrame frame = scene.Frame(f, variant);
     const SlamPose pose = slam.TrackPose(frame);
     const int64_t map = slam.map_generation();
     if (pose.valid) run.live[frame.utime] = pose.cam_from_world;
@@ -214,7 +219,7 @@ TEST(SlamAdjustedTrajectory, AnchoredOnTheKeyframesLastPoses) {
   SlamOptions options = Deterministic();
   options.adjusted_trajectory_refine_keyframes = 0;
   options.max_keyframes = 3;
-  const SceneRun run = RunScene(options, /*odometry_from=*/40, /*loss=*/true);
+  const SceneRun run = RunScene(options, SceneVariant().OdometryFrom(40).Loss());
   ASSERT_GE(run.maps, 2) << "the map was not lost";
   ASSERT_GT(run.seen_keyframes.size(), 10u);
   int anchored = 0, keyframe_images = 0;
@@ -295,7 +300,7 @@ TEST(SlamAdjustedTrajectory, LaterPointsAreGatedOnTheImagesPose) {
   auto run = [](double gate_px) {
     SlamOptions options = Deterministic();
     options.adjusted_trajectory_later_points_px = gate_px;
-    return RunScene(options, -1, false, /*outliers=*/true).refine;
+    return RunScene(options, SceneVariant().Outliers()).refine;
   };
   const SlamSystem::RefineStats gated = run(2.0);
   const SlamSystem::RefineStats open = run(1e6);
@@ -316,9 +321,9 @@ TEST(SlamAdjustedTrajectory, LaterPointsAreGatedOnTheImagesPose) {
 // 6 px off sightings, called moving, never reach the gate (nor the re-resection).
 TEST(SlamAdjustedTrajectory, SightingsCalledMovingWaitForNoLaterPoint) {
   const SlamSystem::RefineStats clean = RunScene(Deterministic()).refine;
-  const SlamSystem::RefineStats called_static = RunScene(Deterministic(), -1, false, /*outliers=*/true).refine;
+  const SlamSystem::RefineStats called_static = RunScene(Deterministic(), SceneVariant().Outliers()).refine;
   const SlamSystem::RefineStats called_moving =
-      RunScene(Deterministic(), -1, false, /*outliers=*/true, false, /*moving_outliers=*/true).refine;
+      RunScene(Deterministic(), SceneVariant().MovingOutliers()).refine;
   RecordProperty("clean_gated", std::to_string(clean.later_gated));
   RecordProperty("static_gated", std::to_string(called_static.later_gated));
   RecordProperty("moving_gated", std::to_string(called_moving.later_gated));
@@ -340,8 +345,8 @@ TEST(SlamAdjustedTrajectory, SightingsCalledMovingWaitForNoLaterPoint) {
 TEST(SlamAdjustedTrajectory, ReleasedTracksLeaveTheReResection) {
   SlamOptions keep = Deterministic();
   keep.adjusted_trajectory_skip_released = false;
-  const SceneRun skipped = RunScene(Deterministic(), -1, false, false, /*released=*/true);
-  const SceneRun kept = RunScene(keep, -1, false, false, /*released=*/true);
+  const SceneRun skipped = RunScene(Deterministic(), SceneVariant().Released());
+  const SceneRun kept = RunScene(keep, SceneVariant().Released());
   const SceneRun none = RunScene(Deterministic());
   RecordProperty("released_skipped", std::to_string(skipped.refine.released_skipped));
   // Tracks drifting off their points are released too, with or without the segmentation
@@ -361,7 +366,7 @@ TEST(SlamAdjustedTrajectory, ReleasedTracksLeaveTheReResection) {
 // Odometry from image 40 makes the map metric once two keyframes with it are 0.3 m apart:
 // the map is rescaled, and so are the images tracked before.
 TEST(SlamAdjustedTrajectory, FollowsTheMetricRescale) {
-  const SceneRun run = RunScene(Deterministic(), /*odometry_from=*/40);
+  const SceneRun run = RunScene(Deterministic(), SceneVariant().OdometryFrom(40));
   ASSERT_TRUE(run.metric);
   // In metres: a rigid alignment (no scale) fits the whole trajectory, the images before
   // the rescale included.
