@@ -1,6 +1,7 @@
 #include "services/perception/slam/object_reconstruction.h"
 
 #include <algorithm>
+#include <limits>
 #include <unordered_map>
 #include <utility>
 
@@ -17,6 +18,49 @@ std::vector<Eigen::Vector3d> MaturePoints(const Map& map, int min_keyframes) {
     if (p.observations.size() >= need) out.push_back(p.position);
   }
   return out;
+}
+
+std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& points, double link_factor) {
+  const size_t n = points.size();
+  if (link_factor <= 0.0 || n < 8) return points;
+  std::vector<double> nearest(n, std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; ++j) {
+      const double d = (points[i] - points[j]).norm();
+      nearest[i] = std::min(nearest[i], d);
+      nearest[j] = std::min(nearest[j], d);
+    }
+  }
+  const double link = link_factor * Median(nearest);
+  // Connected components under links of at most `link` (depth-first).
+  std::vector<int> component(n, -1);
+  std::vector<size_t> sizes;
+  for (size_t seed = 0; seed < n; ++seed) {
+    if (component[seed] >= 0) continue;
+    const int c = static_cast<int>(sizes.size());
+    std::vector<size_t> stack{seed};
+    component[seed] = c;
+    size_t count = 0;
+    while (!stack.empty()) {
+      const size_t i = stack.back();
+      stack.pop_back();
+      ++count;
+      for (size_t j = 0; j < n; ++j) {
+        if (component[j] < 0 && (points[i] - points[j]).norm() <= link) {
+          component[j] = c;
+          stack.push_back(j);
+        }
+      }
+    }
+    sizes.push_back(count);
+  }
+  const int largest = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(sizes[static_cast<size_t>(largest)]);
+  for (size_t i = 0; i < n; ++i) {
+    if (component[i] == largest) kept.push_back(points[i]);
+  }
+  return kept;
 }
 
 std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& points, double max_spread) {
@@ -79,6 +123,7 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   s.rotation_prior_floor_rad = options.rotation_prior_floor_rad;
   s.rotation_prior_rad_per_s = options.rotation_prior_rad_per_s;
   s.rotation_prior_min_inlier_ratio = options.rotation_prior_min_inlier_ratio;
+  s.rotation_prior_keep_inlier_ratio = options.rotation_prior_keep_inlier_ratio;
   return s;
 }
 
@@ -167,6 +212,7 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
     if (r.valid) {
       r.cam_from_obj = pose.cam_from_world;
       r.num_inliers = pose.num_inliers;
+      r.rotation_prior = e.slam->rotation_prior_active();
       std::vector<double> z;
       for (const SlamObservation& so : frame.observations) {
         const int64_t pid = e.slam->map().PointOfTrack(so.track_id);
@@ -178,7 +224,9 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
       if (update.new_keyframe || e.last_points_frame < 0 ||
           frame_index - e.last_points_frame >= options_.points_every_frames) {
         r.points_included = true;
-        r.points = CompactPoints(MaturePoints(e.slam->map(), options_.min_point_keyframes), options_.max_point_spread);
+        r.points = LargestCluster(
+            CompactPoints(MaturePoints(e.slam->map(), options_.min_point_keyframes), options_.max_point_spread),
+            options_.cluster_link_factor);
         e.last_points_frame = frame_index;
       }
     }

@@ -1055,8 +1055,63 @@ bool SlamSystem::NeedKeyframe(const SlamFrame& frame, const std::unordered_map<i
   return Median(angles) > options_.keyframe_parallax_deg * kDeg;
 }
 
+bool SlamSystem::RotationPriorHolds(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const {
+  if (!frame.rotation_prior) return true;
+  // Against the oldest keyframe that still shares enough tracks: between neighbouring
+  // keyframes the turn of a small object is a sideways step within the noise (the
+  // bas-relief ambiguity); over a longer baseline it shows.
+  std::vector<Eigen::Vector2d> xr, xn;
+  const Keyframe* ref = nullptr;
+  for (const auto& [kid, k] : map_.keyframes()) {
+    if (!k.rotation_prior || k.rotation_prior->ref_id != frame.rotation_prior->ref_id) continue;
+    xr.clear();
+    xn.clear();
+    for (const SlamObservation& o : frame.observations) {
+      auto lab = labels.find(o.track_id);
+      if (lab == labels.end() || lab->second != 0) continue;
+      auto it = k.track_xy.find(o.track_id);
+      if (it == k.track_xy.end()) continue;
+      xr.push_back(it->second);
+      xn.push_back(o.xy);
+    }
+    if (static_cast<int>(xr.size()) >= options_.init_min_points) {
+      ref = &k;
+      break;
+    }
+  }
+  if (!ref) return true;  // nothing to test against: a later keyframe will tell
+  const size_t n = xr.size();
+  std::vector<cv::Point2d> pr(n), pn(n);
+  for (size_t i = 0; i < n; ++i) {
+    pr[i] = cv::Point2d(xr[i].x(), xr[i].y());
+    pn[i] = cv::Point2d(xn[i].x(), xn[i].y());
+  }
+  const double thresh = 1.0 / frame.focal_px;
+  cv::Mat e_mask;
+  const cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, e_mask);
+  if (E.empty() || E.rows != 3) return true;
+  const int e_inl = cv::countNonZero(e_mask);
+  const Eigen::Matrix3d R =
+      (frame.rotation_prior->cam_from_ref * ref->rotation_prior->cam_from_ref.conjugate()).toRotationMatrix();
+  const std::optional<KnownRotationTranslation> kt = TranslationGivenRotation(xr, xn, R, thresh, 200);
+  const int known = kt ? kt->count : 0;
+  MBSLAM_LOG(DEBUG) << "SLAM keyframe at frame " << frame.frame_index << ": from frame " << ref->frame_index
+                    << " the known rotation explains " << known << " of the essential matrix's " << e_inl
+                    << " inliers";
+  // Five-point RANSAC also fits a few noisy or foreign tracks the two-parameter fit
+  // leaves out (a straight walker's 16 of 19 on sim-crossing): a turn must cost more.
+  constexpr int kMinDeficit = 5;
+  return known >= options_.rotation_prior_keep_inlier_ratio * e_inl || e_inl - known < kMinDeficit;
+}
+
 void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels,
                              SlamMapUpdate* update) {
+  if (rotation_prior_active_ && options_.rotation_prior_keep_inlier_ratio > 0.0 &&
+      !RotationPriorHolds(frame, labels)) {
+    rotation_prior_active_ = false;
+    MBSLAM_LOG(INFO) << "SLAM: the body turns at frame " << frame.frame_index
+                     << ": no rotation prior for the rest of this map";
+  }
   const Rigid3d T = *PoseOf(frame.frame_index);
   Keyframe kf;
   kf.frame_index = frame.frame_index;

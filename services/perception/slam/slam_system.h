@@ -150,6 +150,11 @@ struct SlamOptions {
   // A map uses the prior only if, at its initialisation, the known rotation explains at
   // least this share of a free essential matrix's inliers (else the body turns).
   double rotation_prior_min_inlier_ratio = 1.0;
+  // ... and keeps it while, at each new keyframe, the known rotation from the oldest
+  // keyframe that shares init_min_points tracks with it explains at least this share of a
+  // free essential matrix's inliers between the two, and no fewer than 5 of them (a body
+  // that walks straight, then turns). 0 = kept for the map's life.
+  double rotation_prior_keep_inlier_ratio = 0.0;
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_SECTION(pose);
@@ -195,6 +200,7 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION_GE(rotation_prior_floor_rad, 0.0);
     MBSLAM_CHECK_OPTION_GE(rotation_prior_rad_per_s, 0.0);
     MBSLAM_CHECK_OPTION(rotation_prior_min_inlier_ratio >= 0.0 && rotation_prior_min_inlier_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION(rotation_prior_keep_inlier_ratio >= 0.0 && rotation_prior_keep_inlier_ratio <= 1.0);
     return true;
   }
   template <typename V>
@@ -376,6 +382,9 @@ class SlamSystem {
   // Counts the maps dropped (Reset, re-initialisation after a loss): the frame of the
   // poses changes with it.
   int64_t map_generation() const { return map_generation_; }
+  // The current map holds the body's rotation to the images' rotation prior (it was
+  // initialised with it and the body has not turned since).
+  bool rotation_prior_active() const { return rotation_prior_active_; }
   int64_t ba_runs() const { return ba_runs_; }
   // The trajectory files' re-resections so far: images re-resected, the points their
   // static tracks got later that were used or left out by the reprojection gate, and the
@@ -394,6 +403,9 @@ class SlamSystem {
 
  private:
   void TryInitialize(const SlamFrame& frame, SlamPose* pose);
+  // The rotation prior still explains the body's motion from the oldest keyframe that
+  // shares init_min_points tracks with this frame (rotation_prior_keep_inlier_ratio).
+  bool RotationPriorHolds(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const;
   void AddKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels,
                    SlamMapUpdate* update);
   bool NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const;
