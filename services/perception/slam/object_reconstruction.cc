@@ -32,6 +32,7 @@ std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& 
     }
   }
   const double link = link_factor * Median(nearest);
+  if (!(link > 0.0)) return points;  // half the points or more duplicated: no scale to link by
   // Connected components under links of at most `link` (depth-first).
   std::vector<int> component(n, -1);
   std::vector<size_t> sizes;
@@ -55,6 +56,9 @@ std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& 
     sizes.push_back(count);
   }
   const int largest = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+  // Only a minority is left out: without a cluster of most points there is no body to
+  // tell apart from the rest.
+  if (2 * sizes[static_cast<size_t>(largest)] < n) return points;
   std::vector<Eigen::Vector3d> kept;
   kept.reserve(sizes[static_cast<size_t>(largest)]);
   for (size_t i = 0; i < n; ++i) {

@@ -1055,6 +1055,11 @@ bool SlamSystem::NeedKeyframe(const SlamFrame& frame, const std::unordered_map<i
   return Median(angles) > options_.keyframe_parallax_deg * kDeg;
 }
 
+bool RotationPriorStillHolds(int known, int essential, double ratio) {
+  constexpr int kAllowedMissing = 4;
+  return known >= ratio * essential || essential - known <= kAllowedMissing;
+}
+
 bool SlamSystem::RotationPriorHolds(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const {
   if (!frame.rotation_prior) return true;
   // Against the oldest keyframe that still shares enough tracks: between neighbouring
@@ -1098,10 +1103,7 @@ bool SlamSystem::RotationPriorHolds(const SlamFrame& frame, const std::unordered
   MBSLAM_LOG(DEBUG) << "SLAM keyframe at frame " << frame.frame_index << ": from frame " << ref->frame_index
                     << " the known rotation explains " << known << " of the essential matrix's " << e_inl
                     << " inliers";
-  // Five-point RANSAC also fits a few noisy or foreign tracks the two-parameter fit
-  // leaves out (a straight walker's 16 of 19 on sim-crossing): a turn must cost more.
-  constexpr int kMinDeficit = 5;
-  return known >= options_.rotation_prior_keep_inlier_ratio * e_inl || e_inl - known < kMinDeficit;
+  return RotationPriorStillHolds(known, e_inl, options_.rotation_prior_keep_inlier_ratio);
 }
 
 void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels,

@@ -152,8 +152,9 @@ struct SlamOptions {
   double rotation_prior_min_inlier_ratio = 1.0;
   // ... and keeps it while, at each new keyframe, the known rotation from the oldest
   // keyframe that shares init_min_points tracks with it explains at least this share of a
-  // free essential matrix's inliers between the two, and no fewer than 5 of them (a body
-  // that walks straight, then turns). 0 = kept for the map's life.
+  // free essential matrix's inliers between the two, or all but 4 of them
+  // (RotationPriorStillHolds; a body that walks straight, then turns). 0 = kept for the
+  // map's life.
   double rotation_prior_keep_inlier_ratio = 0.0;
 
   bool Check() const {
@@ -337,6 +338,13 @@ struct SlamMapUpdate {
   int culled_points = 0;                   // points removed with the culled keyframes (count)
 };
 
+// The keyframe test of the rotation prior (SlamOptions::rotation_prior_keep_inlier_ratio):
+// the known rotation, with a translation fitted to it, explains `known` of the tracks a
+// free essential matrix explains `essential` of. It holds at `ratio` of them, or when at
+// most 4 are missing: five-point RANSAC also fits a few noisy or foreign tracks that the
+// two-parameter fit leaves out (a straight walker's 16 of 19 on sim-crossing).
+bool RotationPriorStillHolds(int known, int essential, double ratio);
+
 class SlamSystem {
  public:
   explicit SlamSystem(const SlamOptions& options);
@@ -513,7 +521,7 @@ class SlamSystem {
   bool metric_ = false;
   bool just_initialized_ = false;
   int64_t map_generation_ = 0;
-  bool rotation_prior_active_ = false;  // this map was initialised with the rotation prior
+  bool rotation_prior_active_ = false;  // this map was initialised with the rotation prior and keeps it
 
   // After a loss the next map continues the previous world frame: the pose is carried
   // over the gap with the last velocity, and (without metric scale) the units follow
