@@ -85,7 +85,7 @@ struct ObjectReconstructionOptions {
   // cluster filter: sim-crossing 15.4 / 104 -> 0.98 / 13; sim-following 18.6 / 39 ->
   // 0.33 / 0.74; sim-previously_static 6.0 / 24 -> 0.56 / 0.37; sim-multi (walkers on
   // ellipses, up to 1.8 rad/s) 4.9 / 26 -> 1.35 / 0.76, but the median over its 8 maps
-  // 4.1 / 45 -> 9.3 / 36 (short maps of turning cars keep the prior). Seeds 2 / 3:
+  // 4.1 / 45 -> 9.3 / 39 (short maps of turning cars keep the prior). Seeds 2 / 3:
   // sim-crossing 21 / 28 -> 1.05 / 3.8 and 330 / 1100 -> 16 / 85. (Both 0 = no prior.) Fed only
   // the person's tracks by the truth masks (a one-off harness; tracking.object_features
   // 50), sim-crossing's map was 23 / 242 without the prior, 6.0 / 55 with the loose one
