@@ -10,6 +10,30 @@
 namespace mbslam {
 namespace {
 
+// The estimated camera positions through the similarity that best fits them to the truth
+// (Umeyama), and the rms error of the result relative to the true path's length.
+struct AlignedTrajectory {
+  Eigen::Matrix4d truth_from_est = Eigen::Matrix4d::Identity();
+  double err_rel_path = 0.0;
+};
+
+AlignedTrajectory AlignTrajectory(const std::vector<Eigen::Vector3d>& est, const std::vector<Eigen::Vector3d>& truth) {
+  Eigen::Matrix3Xd src(3, est.size()), dst(3, truth.size());
+  for (size_t i = 0; i < est.size(); ++i) {
+    src.col(static_cast<Eigen::Index>(i)) = est[i];
+    dst.col(static_cast<Eigen::Index>(i)) = truth[i];
+  }
+  AlignedTrajectory out;
+  out.truth_from_est = Eigen::umeyama(src, dst, true);
+  double err2 = 0.0, path = 0.0;
+  for (size_t i = 0; i < est.size(); ++i) {
+    err2 += ((out.truth_from_est * est[i].homogeneous()).head<3>() - truth[i]).squaredNorm();
+    if (i > 0) path += (truth[i] - truth[i - 1]).norm();
+  }
+  out.err_rel_path = std::sqrt(err2 / static_cast<double>(est.size())) / path;
+  return out;
+}
+
 // A rigid box of points passing in front of a still camera, turning slowly: the
 // object's own SLAM must recover the camera's path w.r.t. the object and its shape up to
 // a similarity.
@@ -56,20 +80,9 @@ TEST(ObjectReconstructionTest, ReconstructsAPassingRigidObject) {
   }
   ASSERT_GE(est_c.size(), 30u) << "the object was reconstructed early";
   EXPECT_EQ(rec.maps_started(), 1);
-  Eigen::Matrix3Xd src(3, est_c.size()), dst(3, true_c.size());
-  for (size_t i = 0; i < est_c.size(); ++i) {
-    src.col(static_cast<Eigen::Index>(i)) = est_c[i];
-    dst.col(static_cast<Eigen::Index>(i)) = true_c[i];
-  }
-  const Eigen::Matrix4d T = Eigen::umeyama(src, dst, true);
-  double err2 = 0.0, path = 0.0;
-  for (size_t i = 0; i < est_c.size(); ++i) {
-    const Eigen::Vector3d a = (T * est_c[i].homogeneous()).head<3>();
-    err2 += (a - true_c[i]).squaredNorm();
-    if (i > 0) path += (true_c[i] - true_c[i - 1]).norm();
-  }
-  const double rmse = std::sqrt(err2 / static_cast<double>(est_c.size()));
-  EXPECT_LT(rmse / path, 0.02) << "camera-relative trajectory within 2 % of its path";
+  const AlignedTrajectory aligned = AlignTrajectory(est_c, true_c);
+  const Eigen::Matrix4d& T = aligned.truth_from_est;
+  EXPECT_LT(aligned.err_rel_path, 0.02) << "camera-relative trajectory within 2 % of its path";
   // Shape: the last output's points against the truth through the same similarity.
   ObjectReconstructionResult with_points;
   for (int k = 60; k < 80 && !with_points.points_included; ++k) {
@@ -252,18 +265,7 @@ WalkerRun RunWalker(const WalkerScene& scene, const ObjectReconstructionOptions&
   }
   run.maps = static_cast<int>(rec.maps_started());
   if (est.size() < 10) return run;
-  Eigen::Matrix3Xd src(3, est.size()), dst(3, est.size());
-  for (size_t i = 0; i < est.size(); ++i) {
-    src.col(static_cast<Eigen::Index>(i)) = est[i];
-    dst.col(static_cast<Eigen::Index>(i)) = truth[i];
-  }
-  const Eigen::Matrix4d T = Eigen::umeyama(src, dst, true);
-  double err2 = 0.0, path = 0.0;
-  for (size_t i = 0; i < est.size(); ++i) {
-    err2 += ((T * est[i].homogeneous()).head<3>() - truth[i]).squaredNorm();
-    if (i > 0) path += (truth[i] - truth[i - 1]).norm();
-  }
-  run.trajectory_err_rel = std::sqrt(err2 / static_cast<double>(est.size())) / path;
+  run.trajectory_err_rel = AlignTrajectory(est, truth).err_rel_path;
   return run;
 }
 
