@@ -88,6 +88,7 @@ int Run(int argc, char** argv) {
   int max_frames = seg_defaults.multibody_max_frames;
   int max_tracks = 400;  // tracks clustered per initialisation (the service default is 250)
   int every = 5;  // re-initialise often: the labels reported are those of the last grouping (multibody_hold)
+  double heading_keep_ratio = seg_defaults.two_view.heading_keep_ratio;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--root" && i + 1 < argc) root = argv[++i];
@@ -115,6 +116,7 @@ int Run(int argc, char** argv) {
     else if (a == "--max-motions" && i + 1 < argc) sc_options.max_motions = std::atoi(argv[++i]);
     else if (a == "--refine" && i + 1 < argc) sc_options.refine_iterations = std::atoi(argv[++i]);
     else if (a == "--subspace-dim" && i + 1 < argc) sc_options.subspace_dimension = std::atoi(argv[++i]);
+    else if (a == "--heading-keep-ratio" && i + 1 < argc) heading_keep_ratio = std::atof(argv[++i]);
     else {
       std::fprintf(stderr, "usage: mbslam-segment-tracks --root DIR [--mode known_k|online|both] [--exclude NAME] [--only NAME]\n");
       return 2;
@@ -156,6 +158,7 @@ int Run(int argc, char** argv) {
   seg_options.multibody_every_frames = every;
   seg_options.multibody_max_frames = max_frames;
   seg_options.multibody_max_tracks = max_tracks;
+  seg_options.two_view.heading_keep_ratio = heading_keep_ratio;
   const bool do_known = mode != "online", do_online = mode != "known_k";
   std::map<std::string, std::vector<double>> known, online;  // "2", "3", "all"
   int online_k_right = 0, sequences = 0;

@@ -44,6 +44,7 @@ void MotionSegmenter::Reset() {
   frame_ = -1;
   first_frame_ = -1;
   last_multibody_frame_ = -1;
+  last_heading_.reset();
 }
 
 double MotionSegmenter::BayesUpdate(double prior, double likelihood, double parallax_px) const {
@@ -152,7 +153,7 @@ void MotionSegmenter::UpdateHistories(const SegmenterInput& in) {
   }
 }
 
-std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput& in, int64_t ref) {
+std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput& in, int64_t ref, bool use_heading) {
   if (in.world_motion) {
     if (auto m = in.world_motion(ref, in.frame_index)) return m;
   }
@@ -175,7 +176,8 @@ std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput&
   }
   RelativeMotion motion;
   std::vector<uint8_t> inliers;
-  if (!EstimateRelativeMotion(xr, xn, in.focal_px, options_.two_view, &motion, &inliers).ok()) {
+  const Eigen::Vector3d* heading = use_heading && last_heading_ ? &*last_heading_ : nullptr;
+  if (!EstimateRelativeMotion(xr, xn, in.focal_px, options_.two_view, &motion, &inliers, heading).ok()) {
     return std::nullopt;
   }
   return motion;
@@ -667,7 +669,7 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
   // young ones.
   int64_t ref = ChooseReference(in);
   if (ref < in.frame_index) {
-    std::optional<RelativeMotion> motion = WorldMotion(in, ref);
+    std::optional<RelativeMotion> motion = WorldMotion(in, ref, /*use_heading=*/true);
     if (motion && !motion->translation_known && options_.translation_lag_tries > 0) {
       const int64_t earliest = EarliestReference(in);
       int64_t lag = in.frame_index - ref;
@@ -675,7 +677,7 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
         lag *= 2;
         const int64_t older = std::max(earliest, in.frame_index - lag);
         if (older >= ref) break;
-        std::optional<RelativeMotion> m = WorldMotion(in, older);
+        std::optional<RelativeMotion> m = WorldMotion(in, older, /*use_heading=*/true);
         if (m && m->translation_known) {
           ref = older;
           motion = std::move(m);
@@ -684,6 +686,10 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
       }
     }
     if (motion) {
+      // The heading the next image's two-view estimate expects (kept across rotations).
+      if (motion->translation_known && motion->cam_n_from_cam_r.translation.norm() > 1e-12) {
+        last_heading_ = motion->cam_n_from_cam_r.translation.normalized();
+      }
       initialized_ = true;
       result.pair_ground_inliers = UpdateStaticProbabilities(in, ref, *motion);
       result.world_motion = motion;

@@ -289,7 +289,8 @@ class MotionSegmenter {
   };
 
   void UpdateHistories(const SegmenterInput& input);
-  std::optional<RelativeMotion> WorldMotion(const SegmenterInput& input, int64_t ref);
+  // `use_heading`: the two-view estimate tries the last image's translation direction.
+  std::optional<RelativeMotion> WorldMotion(const SegmenterInput& input, int64_t ref, bool use_heading = false);
   // Returns the tracks on the pair's ground plane (0 if none was found or used).
   int UpdateStaticProbabilities(const SegmenterInput& input, int64_t ref, const RelativeMotion& motion);
   // The long-baseline flow bound (options long_baseline_*); returns the tracks judged.
@@ -318,6 +319,7 @@ class MotionSegmenter {
   int64_t frame_ = -1;
   int64_t first_frame_ = -1;
   int64_t last_multibody_frame_ = -1;
+  std::optional<Eigen::Vector3d> last_heading_;  // translation direction of the last world motion (current camera)
   bool initialized_ = false;
 };
 

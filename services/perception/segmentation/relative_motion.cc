@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
@@ -274,10 +275,77 @@ int PoseFromEssential(const cv::Mat& E, const std::vector<cv::Point2d>& pr, cons
 
 }  // namespace
 
+// The rotation that best explains the correspondences under a fixed translation
+// direction t (unit): the epipolar residual x_n' [t]x (I + [w]x) R0 x_r is linear in a
+// small rotation w, so three correspondences give a hypothesis (RANSAC with a fixed
+// seed, each hypothesis relinearised once); returns the inlier count (and the motion).
+int RotationGivenHeading(const std::vector<Eigen::Vector2d>& x_r, const std::vector<Eigen::Vector2d>& x_n,
+                         const Eigen::Vector3d& t, const Eigen::Matrix3d& R0, double thresh, int iterations,
+                         Rigid3d* best) {
+  const size_t n = x_r.size();
+  if (n < 3) return 0;
+  const Eigen::Matrix3d Tx = Hat(t);
+  // Linearised about R: residual c_i + g_i' w (unnormalised epipolar residual).
+  auto linearise = [&](const Eigen::Matrix3d& R, size_t i, double* c, Eigen::Vector3d* g) {
+    const Eigen::Vector3d b = R * x_r[i].homogeneous();
+    const Eigen::Vector3d a = Tx.transpose() * x_n[i].homogeneous();  // x_n' [t]x = a'
+    *c = a.dot(b);
+    *g = -(Hat(b).transpose() * a);  // a' (w x b) = a' (-[b]x w)
+  };
+  auto count = [&](const Eigen::Matrix3d& R) {
+    const Eigen::Matrix3d E = Tx * R;
+    int k = 0;
+    for (size_t i = 0; i < n; ++i) k += std::abs(EpipolarDistance(E, x_r[i], x_n[i])) <= thresh;
+    return k;
+  };
+  auto solve = [&](const Eigen::Matrix3d& R, const size_t* idx, size_t m, Eigen::Matrix3d* out) {
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < m; ++k) {
+      double c;
+      Eigen::Vector3d g;
+      linearise(R, idx[k], &c, &g);
+      A += g * g.transpose();
+      rhs -= c * g;
+    }
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(A);
+    if (lu.rank() < 3) return false;
+    const Eigen::Vector3d w = lu.solve(rhs);
+    if (!w.allFinite() || w.norm() > 0.5) return false;
+    *out = ExpSO3(w) * R;
+    return true;
+  };
+  uint64_t state = 0x9e3779b97f4a7c15ull;
+  auto next = [&]() {
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    return state;
+  };
+  int best_count = count(R0);
+  Eigen::Matrix3d best_R = R0;
+  for (int it = 0; it < iterations; ++it) {
+    size_t idx[3];
+    idx[0] = next() % n;
+    idx[1] = next() % n;
+    idx[2] = next() % n;
+    if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2]) continue;
+    Eigen::Matrix3d R1, R2;
+    if (!solve(R0, idx, 3, &R1) || !solve(R1, idx, 3, &R2)) continue;
+    const int k = count(R2);
+    if (k > best_count) {
+      best_count = k;
+      best_R = R2;
+    }
+  }
+  *best = Rigid3d(best_R, t);
+  return best_count;
+}
+
 Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
                               const std::vector<Eigen::Vector2d>& x_n, double focal_px,
                               const TwoViewOptions& options, RelativeMotion* motion,
-                              std::vector<uint8_t>* inliers) {
+                              std::vector<uint8_t>* inliers, const Eigen::Vector3d* heading) {
   const size_t n = x_r.size();
   if (n < static_cast<size_t>(options.min_points) || x_n.size() != n) {
     return Status::Error("too few correspondences (" + std::to_string(n) + ")");
@@ -369,6 +437,56 @@ Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
     return count;
   };
   int e_count = count_inliers(T, inliers);
+  if (heading && options.heading_keep_ratio > 0.0 && heading->norm() > 1e-12) {
+    // The expected heading with the RANSAC solution's rotation or the rotation-only
+    // fit's, refined like the RANSAC solution; the better is kept when it explains
+    // nearly as many correspondences.
+    Rigid3d H;
+    std::vector<uint8_t> h_inliers(n, 0);
+    int h_count = -1;
+    for (const Eigen::Matrix3d& R0 : {T.RotationMatrix(), Eigen::Matrix3d(R_rot)}) {
+      Rigid3d C;
+      RotationGivenHeading(x_r, x_n, heading->normalized(), R0, thresh, 100, &C);
+      std::vector<uint8_t> c_inliers(n, 0);
+      for (int round = 0; round < 2; ++round) {
+        count_inliers(C, &c_inliers);
+        C = RefineMotion(C, x_r, x_n, c_inliers, options.sigma_px / focal_px * 2.0);
+      }
+      const int c_count = count_inliers(C, &c_inliers);
+      if (c_count > h_count) {
+        H = C;
+        h_inliers = std::move(c_inliers);
+        h_count = c_count;
+      }
+    }
+    // The epipolar distances do not see the translation's sign: the sign that puts
+    // fewer inliers behind the cameras is kept, as for the essential matrix's solution.
+    {
+      const Eigen::Matrix3d R = H.RotationMatrix();
+      const double margin = options.front_margin_px / focal_px;
+      int behind = 0, behind_flipped = 0;
+      for (size_t i = 0; i < n; ++i) {
+        if (!h_inliers[i]) continue;
+        const DepthFlow a = DepthFlowOf(R, H.translation, x_r[i], x_n[i]);
+        const DepthFlow b = DepthFlowOf(R, -H.translation, x_r[i], x_n[i]);
+        behind += a.valid && a.flow < -margin;
+        behind_flipped += b.valid && b.flow < -margin;
+      }
+      if (behind_flipped < behind) H.translation = -H.translation;
+    }
+    const double angle_deg =
+        std::acos(std::clamp(H.translation.normalized().dot(T.translation.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+    const bool keep = h_count >= options.min_points && h_count >= options.heading_keep_ratio * e_count;
+    if (angle_deg > 1.0) {
+      MBSLAM_LOG(DEBUG) << "two-view: the expected heading explains " << h_count << " of the essential matrix's "
+                        << e_count << " inliers (" << angle_deg << " deg apart)" << (keep ? ": kept" : "");
+    }
+    if (keep) {
+      T = H;
+      *inliers = std::move(h_inliers);
+      e_count = h_count;
+    }
+  }
   if (options.cheirality_refine) {
     // The epipolar distances hardly see a rotation that slides every point along its
     // epipolar line (about an axis across the translation, for a narrow field of view):

@@ -52,6 +52,12 @@ struct TwoViewOptions {
   double front_margin_px = 2.0;    // flow against the direction of positive depth tolerated as noise (px)
   double max_behind_share = 0.5;   // inliers behind (beyond the margin) above this share trigger the refinement
   double front_keep_ratio = 0.9;   // the refined motion is kept if it keeps this share of the inliers (and fewer behind)
+  // A heading given by the caller (the translation direction of the previous motion: a
+  // camera's heading changes little between images) is refined on the correspondences
+  // and preferred to the RANSAC essential matrix when it explains this share of its
+  // inliers: with sliding, edge-like tracks a wrong direction can win the RANSAC by a few
+  // inliers (0 = off).
+  double heading_keep_ratio = 0.9;
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(sigma_px, 0.0);
@@ -63,6 +69,7 @@ struct TwoViewOptions {
     MBSLAM_CHECK_OPTION_GE(front_margin_px, 0.0);
     MBSLAM_CHECK_OPTION(max_behind_share >= 0.0 && max_behind_share <= 1.0);
     MBSLAM_CHECK_OPTION(front_keep_ratio >= 0.0 && front_keep_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION(heading_keep_ratio >= 0.0 && heading_keep_ratio <= 1.0);
     return true;
   }
   template <typename V>
@@ -78,6 +85,9 @@ struct TwoViewOptions {
     v("front_margin_px", &front_margin_px, "flow against the direction of positive depth tolerated as noise (px)");
     v("max_behind_share", &max_behind_share, "inliers behind (beyond the margin) above this share trigger the refinement");
     v("front_keep_ratio", &front_keep_ratio, "the refined motion is kept if it keeps this share of the inliers (and fewer behind)");
+    v("heading_keep_ratio", &heading_keep_ratio,
+      "a heading given by the caller (the previous motion's), refined, is preferred when it explains this share of "
+      "the essential matrix's inliers (0 = off)");
   }
 };
 
@@ -85,10 +95,12 @@ struct TwoViewOptions {
 // RANSAC, pose recovery with cheirality), or a pure rotation when the parallax is too
 // small for the translation to be observable. Translation has unit norm. The
 // covariance comes from the inliers' epipolar residuals (Gauss-Newton information).
+// `heading` (unit, optional): an expected translation direction, tried against the
+// RANSAC solution (options.heading_keep_ratio).
 Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
                               const std::vector<Eigen::Vector2d>& x_n, double focal_px,
                               const TwoViewOptions& options, RelativeMotion* motion,
-                              std::vector<uint8_t>* inliers);
+                              std::vector<uint8_t>* inliers, const Eigen::Vector3d* heading = nullptr);
 
 // Signed distance (normalised units) of x_n to the epipolar line E x_r. Inline: it runs
 // per track and envelope sample.

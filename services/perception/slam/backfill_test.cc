@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <random>
+#include <unordered_set>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -173,6 +175,98 @@ TEST(SlamBackfill, ShortBaselineInitialisationWaitsForParallax) {
   // When a third of the tracks end just after the first acceptable pair, it goes ahead.
   options.init_wait_frames = 30;
   EXPECT_EQ(InitImage(scene, options, at_once, 200), at_once + 1);
+}
+
+// What the wait does at image at_once + 1 when that image has no acceptable pair
+// (SlamOptions::init_wait_fallback): its observations are `next`.
+struct WaitEnd {
+  int64_t second_keyframe = -1;  // image of the map's second keyframe after image at_once + 1 (-1: no map)
+  bool next_posed = false;       // image at_once + 1 got a live pose
+};
+WaitEnd EndWaitWith(const Scene& scene, SlamOptions options, int at_once,
+                    const std::function<SlamFrame(int)>& next) {
+  options.init_good_parallax_deg = 45.0;  // never good enough: the pair at at_once waits
+  options.init_wait_frames = 30;
+  SlamSystem slam(options);
+  WaitEnd out;
+  for (int f = 0; f <= at_once + 1; ++f) {
+    const SlamFrame frame = f <= at_once ? scene.Frame(f) : next(f);
+    const SlamPose pose = slam.TrackPose(frame);
+    if (f <= at_once) {
+      EXPECT_EQ(slam.map().num_keyframes(), 0u) << "image " << f << " did not wait";
+    } else {
+      out.next_posed = pose.valid;
+      if (slam.map().num_keyframes() >= 2) out.second_keyframe = std::next(slam.map().keyframes().begin())->second.frame_index;
+    }
+    std::unordered_map<int64_t, int> labels;
+    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
+    slam.UpdateMap(frame, labels);
+  }
+  return out;
+}
+
+// A pair waiting for parallax makes the map when the next image's tracks make none
+// (here most tracks end: 45 shared with the reference, below init_min_points); that
+// image is then tracked on it. Without the fallback the pair is lost with its tracks.
+TEST(SlamBackfill, AWaitingPairMakesTheMapWhenItsTracksEnd) {
+  const Scene scene(5);
+  SlamOptions options;
+  options.ba.time_limited = false;
+  options.background_ba = false;
+  options.init_good_parallax_deg = 0.0;
+  const int at_once = InitImage(scene, options);
+  ASSERT_GT(at_once, 0);
+  // The 45 nearest points' tracks go on (those with most parallax, which the pair
+  // triangulated), the others end.
+  std::vector<std::pair<double, int64_t>> by_depth;
+  for (size_t i = 0; i < scene.points.size(); ++i) by_depth.emplace_back(scene.points[i].z(), static_cast<int64_t>(i));
+  std::sort(by_depth.begin(), by_depth.end());
+  std::unordered_set<int64_t> kept;
+  for (size_t i = 0; i < 45; ++i) kept.insert(by_depth[i].second);
+  auto thinned = [&](int f) {
+    SlamFrame frame = scene.Frame(f);
+    auto& obs = frame.observations;
+    obs.erase(std::remove_if(obs.begin(), obs.end(), [&](const SlamObservation& o) { return !kept.count(o.track_id); }),
+              obs.end());
+    return frame;
+  };
+  const WaitEnd on = EndWaitWith(scene, options, at_once, thinned);
+  EXPECT_EQ(on.second_keyframe, at_once);
+  EXPECT_TRUE(on.next_posed);
+  options.init_wait_fallback = false;
+  const WaitEnd off = EndWaitWith(scene, options, at_once, thinned);
+  EXPECT_EQ(off.second_keyframe, -1);
+  EXPECT_FALSE(off.next_posed);
+}
+
+// A later pair of the same reference that shows too little parallax contradicts the
+// waiting pair (its parallax came from something else): here the next image is the
+// reference image turned by 3 deg about the camera centre (no parallax at all). No map is
+// made from the waiting pair.
+TEST(SlamBackfill, AWaitingPairContradictedByThePairAfterItIsDropped) {
+  const Scene scene(5);
+  SlamOptions options;
+  options.ba.time_limited = false;
+  options.background_ba = false;
+  options.init_good_parallax_deg = 0.0;
+  const int at_once = InitImage(scene, options);
+  ASSERT_GT(at_once, 0);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(3.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  auto turned = [&](int f) {
+    SlamFrame frame = scene.Frame(0);
+    frame.frame_index = f;
+    frame.utime = f * 33333;
+    for (SlamObservation& o : frame.observations) {
+      o.xy = (R * o.xy.homogeneous()).hnormalized();
+      o.uv = o.xy * kFocal + Eigen::Vector2d(320.0, 240.0);
+      o.body_id = 0;
+      o.p_static = 0.9;
+    }
+    return frame;
+  };
+  const WaitEnd end = EndWaitWith(scene, options, at_once, turned);
+  EXPECT_EQ(end.second_keyframe, -1);
+  EXPECT_FALSE(end.next_posed);
 }
 
 TEST(SlamBackfill, OffKeepsOnlyLivePoses) {

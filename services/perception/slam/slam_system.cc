@@ -67,6 +67,7 @@ void SlamSystem::Reset() {
   state_ = SlamState::kNotInitialized;
   init_ref_frame_ = -1;
   init_pending_frame_ = -1;
+  init_pending_pair_.reset();
   init_ref_xy_.clear();
   init_ref_odom_.reset();
   init_ref_rotation_prior_.reset();
@@ -332,15 +333,21 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   frame_utime_[frame.frame_index] = frame.utime;
   while (static_cast<int>(frame_utime_.size()) > options_.backfill_max_frames + 64) frame_utime_.erase(frame_utime_.begin());
   if (state_ == SlamState::kNotInitialized || state_ == SlamState::kInitializing) {
-    TryInitialize(frame, &out);
-    last_frame_ = frame.frame_index;
-    if (out.valid) {  // a map without confirmation: this image's pose is published
-      RecordTrajectory(frame.frame_index, out.cam_from_world, map_.LastKeyframe());
-      BackfillPoses(frame.frame_index, &out);
-    } else {
-      RememberUnposed(frame);
+    const bool from_earlier_pair = TryInitialize(frame, &out);
+    if (!from_earlier_pair) {
+      last_frame_ = frame.frame_index;
+      if (out.valid) {  // a map without confirmation: this image's pose is published
+        RecordTrajectory(frame.frame_index, out.cam_from_world, map_.LastKeyframe());
+        BackfillPoses(frame.frame_index, &out);
+      } else {
+        RememberUnposed(frame);
+      }
+      return out;
     }
-    return out;
+    // The map was made from an earlier image's pair: this image is tracked on it (and
+    // confirms it) like the images after an initialisation.
+    out = SlamPose();
+    if (state_ == SlamState::kTracking) BackfillPoses(frame.frame_index, &out);  // no confirmation
   }
   // Tracking: 2D-3D correspondences through the tracks that observe map points and
   // were not labelled moving.
@@ -648,7 +655,28 @@ void SlamSystem::BackfillPoses(int64_t frame, SlamPose* out) {
   unposed_.clear();
 }
 
-void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
+bool SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
+  const InitAttempt attempt = AttemptInitialize(frame, out);
+  if (attempt == InitAttempt::kDeferred) return false;
+  if (attempt == InitAttempt::kBuilt || attempt == InitAttempt::kRefusedGeometry || !options_.init_wait_fallback) {
+    // A pair of the same reference refused for too little parallax or too few points
+    // contradicts the waiting pair (the parallax it had came from something else).
+    init_pending_pair_.reset();
+    return false;
+  }
+  if (!init_pending_pair_) return false;
+  // The wait for more parallax ended without a better pair (the shared tracks thinned
+  // out or no longer span the image): the last acceptable pair makes the map, and this
+  // image is tracked on it.
+  const InitPair pair = std::move(*init_pending_pair_);
+  init_pending_pair_.reset();
+  MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << ": no acceptable pair, the pair of frames "
+                    << pair.ref_frame << "-" << pair.frame_index << " (waiting for parallax) makes the map";
+  BuildInitialMap(pair, out);
+  return true;
+}
+
+SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, SlamPose* out) {
   out->state = state_;
   std::unordered_map<int64_t, Eigen::Vector2d> current;
   for (const SlamObservation& o : frame.observations) {
@@ -673,7 +701,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   if (init_ref_frame_ < 0 || frame.frame_index - init_ref_frame_ > options_.init_max_frames) {
     set_reference();
     out->state = state_;
-    return;
+    return InitAttempt::kRefusedTracks;
   }
   std::vector<int64_t> ids;
   std::vector<Eigen::Vector2d> xr, xn;
@@ -686,12 +714,19 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
     xn.push_back(x);
     disp.push_back((x - it->second).norm() * frame.focal_px);
   }
-  if (static_cast<int>(ids.size()) < options_.init_min_tracks) {
+  // While an acceptable pair waits for parallax, its reference is kept as long as
+  // init_min_points tracks are shared (init_min_tracks are needed to start one): this
+  // image may still make a pair with more parallax, else the waiting pair makes the map.
+  const int min_shared = init_pending_pair_ && options_.init_wait_fallback
+                             ? options_.init_min_points
+                             : options_.init_min_tracks;
+  if (static_cast<int>(ids.size()) < min_shared) {
     set_reference();  // the reference has too few tracks left
     out->state = state_;
-    return;
+    return InitAttempt::kRefusedTracks;
   }
-  if (Median(disp) < 8.0) return;  // not enough motion yet
+  // Not enough motion yet (a pending pair keeps waiting).
+  if (Median(disp) < 8.0) return InitAttempt::kDeferred;
 
   const double thresh = 1.0 / frame.focal_px;
   std::unordered_set<int64_t> other_motion;  // members of the motions not chosen (kept out of the map)
@@ -727,7 +762,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
                         << all[0].coverage;
       if (all[0].coverage < options_.init_min_coverage) set_reference();
       out->state = state_;
-      return;
+      return InitAttempt::kRefusedTracks;
     }
     // When the largest motion is the static world (the usual case) the two-view estimate
     // below runs on all tracks as before. Otherwise only the chosen motion's tracks enter
@@ -774,7 +809,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   std::vector<Candidate> candidates;
   cv::Mat e_mask, h_mask;
   cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, e_mask);
-  if (E.empty() || E.rows != 3) return;
+  if (E.empty() || E.rows != 3) return InitAttempt::kRefusedGeometry;
   const int e_inl = cv::countNonZero(e_mask);
   int h_inl = 0;
   bool planar = false;
@@ -805,7 +840,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
       cv::Mat R, t, mask = e_mask.clone();
       if (cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask) <
           options_.init_min_points) {
-        return;
+        return InitAttempt::kRefusedGeometry;
       }
       Eigen::Matrix3d Re;
       Eigen::Vector3d te;
@@ -858,7 +893,7 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
                       << ", H inliers " << h_inl << (planar ? " (planar)" : "") << ", points "
                       << (best ? best->points.size() : 0) << ", median parallax "
                       << (best ? best->median_parallax / kDeg : 0.0) << " deg";
-    return;  // refuse for now; more parallax will come (or the reference is replaced)
+    return InitAttempt::kRefusedGeometry;  // refuse for now; more parallax will come (or the reference is replaced)
   }
   // The points that would make the map (those with parallax) must span the image too:
   // when the background only rotates, a followed object is all that has parallax.
@@ -878,9 +913,34 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
       MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": the " << best->points.size()
                         << " points with parallax cover " << map_coverage << " of the image, "
                         << mapped[0].hull_share << " inside moving hulls";
-      return;
+      return InitAttempt::kRefusedTracks;
     }
   }
+
+  InitPair pair;
+  pair.ref_frame = init_ref_frame_;
+  pair.ref_utime = init_ref_utime_;
+  pair.ref_xy = init_ref_xy_;
+  pair.ref_odom = init_ref_odom_;
+  pair.ref_rotation_prior = init_ref_rotation_prior_;
+  pair.frame_index = frame.frame_index;
+  pair.utime = frame.utime;
+  pair.xy = current;
+  for (const SlamObservation& o : frame.observations) {
+    if (current.count(o.track_id)) pair.uv[o.track_id] = o.uv;
+  }
+  pair.odom = frame.odom_from_cam;
+  pair.rotation_prior = frame.rotation_prior;
+  pair.mean_gray = frame.mean_gray;
+  pair.focal_px = frame.focal_px;
+  pair.cam1_from_cam0 = best->T;
+  pair.points.reserve(best->points.size());
+  for (const auto& [i, X] : best->points) pair.points.push_back(InitPair::Point{ids[i], X, xr[i], xn[i]});
+  pair.other_motion = std::move(other_motion);
+  pair.planar = planar;
+  pair.rotation_prior_active = rotation_prior_active_;
+  pair.median_parallax_rad = best->median_parallax;
+  pair.coverage = map_coverage;
 
   // Acceptable, but from a short baseline: wait for more parallax while the tracks last.
   if (options_.init_good_parallax_deg > 0.0 && best->median_parallax < options_.init_good_parallax_deg * kDeg) {
@@ -894,18 +954,25 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
       MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << " deferred: median parallax "
                         << best->median_parallax / kDeg << " deg, " << shared << " of " << init_pending_tracks_
                         << " tracks shared (acceptable since frame " << init_pending_frame_ << ")";
-      return;
+      init_pending_pair_ = std::move(pair);
+      return InitAttempt::kDeferred;
     }
   }
 
-  // Build the map: keyframe 0 at the reference (fixed gauge), keyframe 1 here.
+  BuildInitialMap(pair, out);
+  return InitAttempt::kBuilt;
+}
+
+void SlamSystem::BuildInitialMap(const InitPair& pair, SlamPose* out) {
+  rotation_prior_active_ = pair.rotation_prior_active;
+  // Build the map: keyframe 0 at the reference (fixed gauge), keyframe 1 at the pair's image.
   map_.Clear();
   recent_poses_.clear();
   // Scale: metric from the odometry baseline when available, else median depth 1.
   double scale = 1.0;
   metric_ = false;
-  if (options_.use_odometry && init_ref_odom_ && frame.odom_from_cam) {
-    const double baseline = (frame.odom_from_cam->Inverse() * *init_ref_odom_).translation.norm();
+  if (options_.use_odometry && pair.ref_odom && pair.odom) {
+    const double baseline = (pair.odom->Inverse() * *pair.ref_odom).translation.norm();
     if (baseline > 1e-3) {
       scale = baseline;  // translation of the two-view motion has unit norm
       metric_ = true;
@@ -913,76 +980,75 @@ void SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   }
   if (!metric_) {
     std::vector<double> depths;
-    for (const auto& [i, X] : best->points) depths.push_back(X.z());
+    for (const InitPair::Point& pt : pair.points) depths.push_back(pt.X.z());
     scale = 1.0 / std::max(1e-9, Median(depths));
   }
   Keyframe k0;
-  k0.frame_index = init_ref_frame_;
-  k0.utime = init_ref_utime_;
+  k0.frame_index = pair.ref_frame;
+  k0.utime = pair.ref_utime;
   k0.cam_from_world = Rigid3d();
-  k0.rotation_prior = init_ref_rotation_prior_;
+  k0.rotation_prior = pair.ref_rotation_prior;
   k0.fixed = true;
-  k0.track_xy = init_ref_xy_;
-  for (int64_t id : other_motion) {
-    k0.track_xy.erase(id);
-    current.erase(id);
-  }
-  if (init_ref_odom_) {
-    k0.has_odometry = true;
-    k0.odom_from_cam = *init_ref_odom_;
-  }
+  k0.track_xy = pair.ref_xy;
   Keyframe k1;
-  k1.frame_index = frame.frame_index;
-  k1.utime = frame.utime;
-  k1.cam_from_world = Rigid3d(best->T.rotation, best->T.translation * scale);
-  k1.track_xy = current;
-  for (const SlamObservation& o : frame.observations) {
-    if (current.count(o.track_id)) k1.track_uv[o.track_id] = o.uv;
+  k1.frame_index = pair.frame_index;
+  k1.utime = pair.utime;
+  k1.cam_from_world = Rigid3d(pair.cam1_from_cam0.rotation, pair.cam1_from_cam0.translation * scale);
+  k1.track_xy = pair.xy;
+  k1.track_uv = pair.uv;
+  for (int64_t id : pair.other_motion) {
+    k0.track_xy.erase(id);
+    k1.track_xy.erase(id);
+    k1.track_uv.erase(id);
   }
-  if (frame.odom_from_cam) {
+  if (pair.ref_odom) {
+    k0.has_odometry = true;
+    k0.odom_from_cam = *pair.ref_odom;
+  }
+  if (pair.odom) {
     k1.has_odometry = true;
-    k1.odom_from_cam = *frame.odom_from_cam;
+    k1.odom_from_cam = *pair.odom;
   }
-  k1.rotation_prior = frame.rotation_prior;
+  k1.rotation_prior = pair.rotation_prior;
   const int64_t id0 = map_.AddKeyframe(std::move(k0));
   const int64_t id1 = map_.AddKeyframe(std::move(k1));
-  for (const auto& [i, X] : best->points) {
+  for (const InitPair::Point& pt : pair.points) {
     MapPoint p;
-    p.position = X * scale;
-    p.track_id = ids[i];
-    p.created_frame = frame.frame_index;
-    p.last_seen_frame = frame.frame_index;
-    p.gray = frame.mean_gray;
+    p.position = pt.X * scale;
+    p.track_id = pt.track_id;
+    p.created_frame = pair.frame_index;
+    p.last_seen_frame = pair.frame_index;
+    p.gray = pair.mean_gray;
     const int64_t pid = map_.AddPoint(std::move(p));
-    map_.AddObservation(pid, id0, xr[i]);
-    map_.AddObservation(pid, id1, xn[i]);
+    map_.AddObservation(pid, id0, pt.xr);
+    map_.AddObservation(pid, id1, pt.xn);
   }
   // Global BA of the two views, inline.
-  BaProblem problem = ExtractBa(2, true, frame.focal_px, metric_);
+  BaProblem problem = ExtractBa(2, true, pair.focal_px, metric_);
   const BaSummary s = SolveBa(&problem, options_.ba);
   if (s.usable) ApplyBaResult(problem, options_.ba, &map_);
   ++ba_runs_;
-  if (bridge_) ApplyBridge(init_ref_frame_, frame.frame_index);
+  if (bridge_) ApplyBridge(pair.ref_frame, pair.frame_index);
   const Keyframe& kf1 = *map_.keyframe(id1);
   // Covariances of the two views: small (a few hundredths of a pixel-equivalent).
-  const Matrix6d init_cov = Matrix6d::Identity() * std::pow(0.5 / frame.focal_px, 2);
+  const Matrix6d init_cov = Matrix6d::Identity() * std::pow(0.5 / pair.focal_px, 2);
   FramePose p0;
   p0.cam_from_world = map_.keyframe(id0)->cam_from_world;
   p0.covariance = init_cov;
   p0.anchor_keyframe = id0;
-  recent_poses_[init_ref_frame_] = p0;
+  recent_poses_[pair.ref_frame] = p0;
   FramePose p1;
   p1.cam_from_world = kf1.cam_from_world;
   p1.covariance = init_cov;
   p1.anchor_keyframe = id1;
-  recent_poses_[frame.frame_index] = p1;
-  last_keyframe_frame_ = frame.frame_index;
+  recent_poses_[pair.frame_index] = p1;
+  last_keyframe_frame_ = pair.frame_index;
   tracked_points_at_keyframe_ = static_cast<int>(map_.num_points());
   state_ = options_.init_confirm_frames > 0 ? SlamState::kConfirming : SlamState::kTracking;
   confirm_count_ = 0;
-  MBSLAM_LOG(INFO) << "SLAM: initialised from frames " << init_ref_frame_ << "-" << frame.frame_index << " with "
-                   << map_.num_points() << " points (" << (planar ? "homography" : "essential")
-                   << ", median parallax " << best->median_parallax / kDeg << " deg, coverage " << map_coverage
+  MBSLAM_LOG(INFO) << "SLAM: initialised from frames " << pair.ref_frame << "-" << pair.frame_index << " with "
+                   << map_.num_points() << " points (" << (pair.planar ? "homography" : "essential")
+                   << ", median parallax " << pair.median_parallax_rad / kDeg << " deg, coverage " << pair.coverage
                    << (metric_ ? ", metric scale from odometry" : "") << ")";
   out->state = state_;
   out->valid = state_ == SlamState::kTracking;

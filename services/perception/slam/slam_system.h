@@ -26,6 +26,7 @@
 #include <optional>
 #include <thread>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include <Eigen/Core>
@@ -69,6 +70,13 @@ struct SlamOptions {
   double init_good_parallax_deg = 3.0;   // median parallax that ends the wait at once (deg; 0 = no waiting)
   int init_wait_frames = 15;             // the longest wait for it after the first acceptable pair (frames)
   double init_wait_keep_ratio = 0.8;     // wait only while this share of the first acceptable pair's tracks is still shared
+  // The wait ends at the first image whose pair is refused for its tracks (fewer than
+  // init_min_points shared with the reference, or not spanning the image): the last
+  // acceptable pair then makes the map, and that image is tracked on it. A pair refused
+  // for too little parallax or too few points contradicts the waiting pair, which is
+  // dropped. Off: the waiting pair is dropped whenever the wait ends without a map
+  // (short-lived tracks lose it).
+  bool init_wait_fallback = true;
   // Images without a pose (before and during initialisation, while lost) are kept this
   // many at most; when a map is confirmed their poses are recovered against it (the
   // trajectory files include them; the live pose stream cannot) (frames, <= 60; 0 = off).
@@ -223,6 +231,8 @@ struct SlamOptions {
     v("init_wait_frames", &init_wait_frames, "longest wait for more parallax after the first acceptable pair (frames)");
     v("init_wait_keep_ratio", &init_wait_keep_ratio,
       "wait only while this share of the first acceptable pair's shared tracks survives");
+    v("init_wait_fallback", &init_wait_fallback,
+      "an image of the wait for parallax without an acceptable pair ends it: the last acceptable pair makes the map");
     v("backfill_max_frames", &backfill_max_frames,
       "images without a pose kept to recover their poses once a map is confirmed, for the trajectory "
       "files (frames, <= 60; 0 = off)");
@@ -410,7 +420,48 @@ class SlamSystem {
   Status LoadMap(const std::string& path);
 
  private:
-  void TryInitialize(const SlamFrame& frame, SlamPose* pose);
+  // An acceptable initialisation: both views and the chosen motion with its points.
+  struct InitPair {
+    // Reference view (keyframe 0).
+    int64_t ref_frame = -1;
+    int64_t ref_utime = 0;
+    std::unordered_map<int64_t, Eigen::Vector2d> ref_xy;
+    std::optional<Rigid3d> ref_odom;
+    std::optional<CameraRotationPrior> ref_rotation_prior;
+    // Second view (keyframe 1).
+    int64_t frame_index = -1;
+    int64_t utime = 0;
+    std::unordered_map<int64_t, Eigen::Vector2d> xy;
+    std::unordered_map<int64_t, Eigen::Vector2d> uv;
+    std::optional<Rigid3d> odom;
+    std::optional<CameraRotationPrior> rotation_prior;
+    uint8_t mean_gray = 128;
+    double focal_px = 1.0;
+    // cam1_from_cam0 with a unit translation, and the points triangulated in cam0.
+    Rigid3d cam1_from_cam0;
+    struct Point {
+      int64_t track_id = 0;
+      Eigen::Vector3d X = Eigen::Vector3d::Zero();
+      Eigen::Vector2d xr = Eigen::Vector2d::Zero();
+      Eigen::Vector2d xn = Eigen::Vector2d::Zero();
+    };
+    std::vector<Point> points;
+    std::unordered_set<int64_t> other_motion;  // tracks of the motions not chosen
+    bool planar = false;
+    bool rotation_prior_active = false;
+    double median_parallax_rad = 0.0;
+    double coverage = 0.0;
+  };
+  // TryInitialize's attempt on one image: kBuilt (a map); kDeferred (acceptable and
+  // waiting for parallax, or too little motion to try); refused for the pair's geometry
+  // (too little parallax, too few points) or for its tracks (too few shared with the
+  // reference, or not spanning the image).
+  enum class InitAttempt { kRefusedGeometry, kRefusedTracks, kDeferred, kBuilt };
+  // Returns true when a map was made from an earlier image's pair (init_pending_pair_)
+  // because this image's tracks made none: the image is then tracked on it.
+  bool TryInitialize(const SlamFrame& frame, SlamPose* pose);
+  InitAttempt AttemptInitialize(const SlamFrame& frame, SlamPose* pose);
+  void BuildInitialMap(const InitPair& pair, SlamPose* pose);
   // The rotation prior still explains the body's motion from the oldest keyframe that
   // shares init_min_points tracks with this frame (rotation_prior_keep_inlier_ratio).
   bool RotationPriorHolds(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const;
@@ -446,6 +497,9 @@ class SlamSystem {
   int64_t init_ref_frame_ = -1;
   int64_t init_pending_frame_ = -1;  // first image that would have made an acceptable map with this reference
   int init_pending_tracks_ = 0;      // tracks it shared with the reference
+  // The latest acceptable pair while waiting for parallax: made into the map when a later
+  // image of the wait has none (init_wait_fallback).
+  std::optional<InitPair> init_pending_pair_;
   std::unordered_map<int64_t, Eigen::Vector2d> init_ref_xy_;
   std::optional<Rigid3d> init_ref_odom_;
   std::optional<CameraRotationPrior> init_ref_rotation_prior_;
