@@ -686,7 +686,8 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
       }
     }
     if (motion) {
-      // The heading the next image's two-view estimate expects (kept across rotations).
+      // The heading the next image's two-view estimate expects: this motion's, if it
+      // measured one (a heading kept over images that did not would go stale).
       if (motion->translation_known && motion->cam_n_from_cam_r.translation.norm() > 1e-12) {
         last_heading_ = motion->cam_n_from_cam_r.translation.normalized();
       }

@@ -177,26 +177,38 @@ TEST(SlamBackfill, ShortBaselineInitialisationWaitsForParallax) {
   EXPECT_EQ(InitImage(scene, options, at_once, 200), at_once + 1);
 }
 
-// What the wait does at image at_once + 1 when that image has no acceptable pair
-// (SlamOptions::init_wait_fallback): its observations are `next`.
+// The tracks of the `count` points nearest the camera.
+std::vector<int64_t> NearestTracks(const Scene& scene, size_t count) {
+  std::vector<std::pair<double, int64_t>> by_depth;
+  for (size_t i = 0; i < scene.points.size(); ++i) by_depth.emplace_back(scene.points[i].z(), static_cast<int64_t>(i));
+  std::sort(by_depth.begin(), by_depth.end());
+  std::vector<int64_t> ids;
+  for (size_t i = 0; i < std::min(count, by_depth.size()); ++i) ids.push_back(by_depth[i].second);
+  return ids;
+}
+
+// What the wait for parallax does after image at_once, where an acceptable pair waits
+// (SlamOptions::init_wait_fallback), when the images after it are `next`.
 struct WaitEnd {
   int64_t second_keyframe = -1;  // image of the map's second keyframe after image at_once + 1 (-1: no map)
   bool next_posed = false;       // image at_once + 1 got a live pose
 };
 WaitEnd EndWaitWith(const Scene& scene, SlamOptions options, int at_once,
-                    const std::function<SlamFrame(int)>& next) {
+                    const std::function<SlamFrame(int)>& next, int images_after = 1) {
   options.init_good_parallax_deg = 45.0;  // never good enough: the pair at at_once waits
   options.init_wait_frames = 30;
   SlamSystem slam(options);
   WaitEnd out;
-  for (int f = 0; f <= at_once + 1; ++f) {
+  for (int f = 0; f <= at_once + images_after; ++f) {
     const SlamFrame frame = f <= at_once ? scene.Frame(f) : next(f);
     const SlamPose pose = slam.TrackPose(frame);
     if (f <= at_once) {
       EXPECT_EQ(slam.map().num_keyframes(), 0u) << "image " << f << " did not wait";
     } else {
-      out.next_posed = pose.valid;
-      if (slam.map().num_keyframes() >= 2) out.second_keyframe = std::next(slam.map().keyframes().begin())->second.frame_index;
+      if (f == at_once + 1) out.next_posed = pose.valid;
+      if (slam.map().num_keyframes() >= 2 && out.second_keyframe < 0) {
+        out.second_keyframe = std::next(slam.map().keyframes().begin())->second.frame_index;
+      }
     }
     std::unordered_map<int64_t, int> labels;
     for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
@@ -218,11 +230,8 @@ TEST(SlamBackfill, AWaitingPairMakesTheMapWhenItsTracksEnd) {
   ASSERT_GT(at_once, 0);
   // The 45 nearest points' tracks go on (those with most parallax, which the pair
   // triangulated), the others end.
-  std::vector<std::pair<double, int64_t>> by_depth;
-  for (size_t i = 0; i < scene.points.size(); ++i) by_depth.emplace_back(scene.points[i].z(), static_cast<int64_t>(i));
-  std::sort(by_depth.begin(), by_depth.end());
   std::unordered_set<int64_t> kept;
-  for (size_t i = 0; i < 45; ++i) kept.insert(by_depth[i].second);
+  for (int64_t id : NearestTracks(scene, 45)) kept.insert(id);
   auto thinned = [&](int f) {
     SlamFrame frame = scene.Frame(f);
     auto& obs = frame.observations;
@@ -242,7 +251,7 @@ TEST(SlamBackfill, AWaitingPairMakesTheMapWhenItsTracksEnd) {
 // A later pair of the same reference that shows too little parallax contradicts the
 // waiting pair (its parallax came from something else): here the next image is the
 // reference image turned by 3 deg about the camera centre (no parallax at all). No map is
-// made from the waiting pair.
+// made from the waiting pair, then or when most tracks end in the image after.
 TEST(SlamBackfill, AWaitingPairContradictedByThePairAfterItIsDropped) {
   const Scene scene(5);
   SlamOptions options;
@@ -264,7 +273,19 @@ TEST(SlamBackfill, AWaitingPairContradictedByThePairAfterItIsDropped) {
     }
     return frame;
   };
-  const WaitEnd end = EndWaitWith(scene, options, at_once, turned);
+  // Then most tracks end, which would make the waiting pair the map had it not been
+  // dropped.
+  std::unordered_set<int64_t> kept;
+  for (int64_t id : NearestTracks(scene, 45)) kept.insert(id);
+  auto next = [&](int f) {
+    if (f == at_once + 1) return turned(f);
+    SlamFrame frame = scene.Frame(f);
+    auto& obs = frame.observations;
+    obs.erase(std::remove_if(obs.begin(), obs.end(), [&](const SlamObservation& o) { return !kept.count(o.track_id); }),
+              obs.end());
+    return frame;
+  };
+  const WaitEnd end = EndWaitWith(scene, options, at_once, next, 2);
   EXPECT_EQ(end.second_keyframe, -1);
   EXPECT_FALSE(end.next_posed);
 }

@@ -71,11 +71,13 @@ struct SlamOptions {
   int init_wait_frames = 15;             // the longest wait for it after the first acceptable pair (frames)
   double init_wait_keep_ratio = 0.8;     // wait only while this share of the first acceptable pair's tracks is still shared
   // The wait ends at the first image whose pair is refused for its tracks (fewer than
-  // init_min_points shared with the reference, or not spanning the image): the last
-  // acceptable pair then makes the map, and that image is tracked on it. A pair refused
-  // for too little parallax or too few points contradicts the waiting pair, which is
-  // dropped. Off: the waiting pair is dropped whenever the wait ends without a map
-  // (short-lived tracks lose it).
+  // init_min_points shared with the reference, tracks or points that no longer span the
+  // image, or the reference expired): the last acceptable pair then makes the map, and
+  // that image is tracked on it. A pair refused for its geometry (too little parallax or
+  // too few points, E or pose recovery failed, parallax inside moving hulls) drops the
+  // waiting pair. So the fallback fires where tracks end abruptly or stop spanning the
+  // image, not where they fade until too few points are left. Off: the waiting pair is
+  // dropped whenever the wait ends without a map (short-lived tracks lose it).
   bool init_wait_fallback = true;
   // Images without a pose (before and during initialisation, while lost) are kept this
   // many at most; when a map is confirmed their poses are recovered against it (the
@@ -232,7 +234,8 @@ struct SlamOptions {
     v("init_wait_keep_ratio", &init_wait_keep_ratio,
       "wait only while this share of the first acceptable pair's shared tracks survives");
     v("init_wait_fallback", &init_wait_fallback,
-      "an image of the wait for parallax without an acceptable pair ends it: the last acceptable pair makes the map");
+      "an image of the wait for parallax whose pair is refused for its tracks ends it: the waiting pair makes the map "
+      "(a pair refused for its geometry drops it)");
     v("backfill_max_frames", &backfill_max_frames,
       "images without a pose kept to recover their poses once a map is confirmed, for the trajectory "
       "files (frames, <= 60; 0 = off)");
