@@ -273,8 +273,6 @@ int PoseFromEssential(const cv::Mat& E, const std::vector<cv::Point2d>& pr, cons
   return good;
 }
 
-}  // namespace
-
 // The rotation that best explains the correspondences under a fixed translation
 // direction t (unit): the epipolar residual x_n' [t]x (I + [w]x) R0 x_r is linear in a
 // small rotation w, so three correspondences give a hypothesis (RANSAC with a fixed
@@ -341,6 +339,8 @@ int RotationGivenHeading(const std::vector<Eigen::Vector2d>& x_r, const std::vec
   *best = Rigid3d(best_R, t);
   return best_count;
 }
+
+}  // namespace
 
 Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
                               const std::vector<Eigen::Vector2d>& x_n, double focal_px,

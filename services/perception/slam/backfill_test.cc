@@ -187,6 +187,18 @@ std::vector<int64_t> NearestTracks(const Scene& scene, size_t count) {
   return ids;
 }
 
+// Image f of the scene with only the tracks of the `count` points nearest the camera
+// (those with most parallax): the others have ended.
+SlamFrame ThinnedFrame(const Scene& scene, size_t count, int f) {
+  std::unordered_set<int64_t> kept;
+  for (int64_t id : NearestTracks(scene, count)) kept.insert(id);
+  SlamFrame frame = scene.Frame(f);
+  auto& obs = frame.observations;
+  obs.erase(std::remove_if(obs.begin(), obs.end(), [&](const SlamObservation& o) { return !kept.count(o.track_id); }),
+            obs.end());
+  return frame;
+}
+
 // What the wait for parallax does after image at_once, where an acceptable pair waits
 // (SlamOptions::init_wait_fallback), when the images after it are `next`.
 struct WaitEnd {
@@ -230,15 +242,7 @@ TEST(SlamBackfill, AWaitingPairMakesTheMapWhenItsTracksEnd) {
   ASSERT_GT(at_once, 0);
   // The 45 nearest points' tracks go on (those with most parallax, which the pair
   // triangulated), the others end.
-  std::unordered_set<int64_t> kept;
-  for (int64_t id : NearestTracks(scene, 45)) kept.insert(id);
-  auto thinned = [&](int f) {
-    SlamFrame frame = scene.Frame(f);
-    auto& obs = frame.observations;
-    obs.erase(std::remove_if(obs.begin(), obs.end(), [&](const SlamObservation& o) { return !kept.count(o.track_id); }),
-              obs.end());
-    return frame;
-  };
+  auto thinned = [&](int f) { return ThinnedFrame(scene, 45, f); };
   const WaitEnd on = EndWaitWith(scene, options, at_once, thinned);
   EXPECT_EQ(on.second_keyframe, at_once);
   EXPECT_TRUE(on.next_posed);
@@ -275,16 +279,7 @@ TEST(SlamBackfill, AWaitingPairContradictedByThePairAfterItIsDropped) {
   };
   // Then most tracks end, which would make the waiting pair the map had it not been
   // dropped.
-  std::unordered_set<int64_t> kept;
-  for (int64_t id : NearestTracks(scene, 45)) kept.insert(id);
-  auto next = [&](int f) {
-    if (f == at_once + 1) return turned(f);
-    SlamFrame frame = scene.Frame(f);
-    auto& obs = frame.observations;
-    obs.erase(std::remove_if(obs.begin(), obs.end(), [&](const SlamObservation& o) { return !kept.count(o.track_id); }),
-              obs.end());
-    return frame;
-  };
+  auto next = [&](int f) { return f == at_once + 1 ? turned(f) : ThinnedFrame(scene, 45, f); };
   const WaitEnd end = EndWaitWith(scene, options, at_once, next, 2);
   EXPECT_EQ(end.second_keyframe, -1);
   EXPECT_FALSE(end.next_posed);

@@ -339,8 +339,8 @@ class FeatureTracker {
   DiscStamp disc_{0};  // min-distance discs of DetectNew
   int64_t frame_index_ = -1;
   TrackerStats stats_;
-  bool last_rejected_ = false;
-  double last_median_flow_px_ = 0.0;  // of the previous image's matched tracks  // the previous image was rejected as a glitch
+  bool last_rejected_ = false;  // the previous image was rejected as a glitch
+  double last_median_flow_px_ = 0.0;  // of the previous image's matched tracks
 };
 
 }  // namespace mbslam
