@@ -1,5 +1,7 @@
 #include "services/perception/slam/object_reconstruction.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <limits>
 #include <unordered_map>
@@ -82,6 +84,53 @@ std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& p
   kept.reserve(points.size());
   for (const Eigen::Vector3d& p : points) {
     if ((p - centre).norm() <= limit) kept.push_back(p);
+  }
+  return kept;
+}
+
+std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d>& points, double max_mads,
+                                               double min_mad_share) {
+  if (max_mads <= 0.0 || points.size() < 8) return points;
+  std::vector<double> coords[3];
+  for (const Eigen::Vector3d& p : points) {
+    for (int a = 0; a < 3; ++a) coords[a].push_back(p[a]);
+  }
+  const Eigen::Vector3d centre(Median(coords[0]), Median(coords[1]), Median(coords[2]));
+  // The body's axes from its inner half (points within the median distance of the centre):
+  // the outliers this is for would tilt them.
+  std::vector<double> distances;
+  for (const Eigen::Vector3d& p : points) distances.push_back((p - centre).norm());
+  const double inner = Median(distances);
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  int n_inner = 0;
+  for (const Eigen::Vector3d& p : points) {
+    if ((p - centre).norm() > inner) continue;
+    cov += (p - centre) * (p - centre).transpose();
+    ++n_inner;
+  }
+  if (n_inner < 4) return points;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const Eigen::Matrix3d axes = eig.eigenvectors();  // columns
+  Eigen::Vector3d med, mad;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<double> proj, dev;
+    for (const Eigen::Vector3d& p : points) proj.push_back(axes.col(a).dot(p - centre));
+    med[a] = Median(proj);
+    for (double x : proj) dev.push_back(std::abs(x - med[a]));
+    mad[a] = Median(dev);
+  }
+  // A side the tracks barely cover (points mostly on one face) has a small deviation:
+  // it is floored at a share of the largest one.
+  const double floor = min_mad_share * mad.maxCoeff();
+  if (!(floor > 0.0)) return points;
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) {
+    bool inside = true;
+    for (int a = 0; a < 3 && inside; ++a) {
+      inside = std::abs(axes.col(a).dot(p - centre) - med[a]) <= max_mads * std::max(mad[a], floor);
+    }
+    if (inside) kept.push_back(p);
   }
   return kept;
 }
@@ -228,9 +277,11 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
       if (update.new_keyframe || e.last_points_frame < 0 ||
           frame_index - e.last_points_frame >= options_.points_every_frames) {
         r.points_included = true;
-        r.points = LargestCluster(
-            CompactPoints(MaturePoints(e.slam->map(), options_.min_point_keyframes), options_.max_point_spread),
-            options_.cluster_link_factor);
+        r.points = AxisCompactPoints(
+            LargestCluster(CompactPoints(MaturePoints(e.slam->map(), options_.min_point_keyframes),
+                                         options_.max_point_spread),
+                           options_.cluster_link_factor),
+            options_.max_axis_mads, options_.min_axis_mad_share);
         e.last_points_frame = frame_index;
       }
     }

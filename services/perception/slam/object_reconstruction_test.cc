@@ -152,6 +152,33 @@ TEST(ObjectReconstructionTest, PublishedPointsLeaveOutPointsFarOutsideTheBody) {
 }
 
 
+// Published points along the body's principal axes: on sim-crossing a second mover walking
+// parallel to the person (the same essential matrix) joined its segment from image 178 and
+// its points lay in a chain off the person's thin side, 0.4-1.1 m from a body 0.4 m wide,
+// which neither the radius about the median nor the clusters leave out.
+TEST(ObjectReconstructionTest, PublishedPointsStayWithinTheBodysAxes) {
+  std::vector<Eigen::Vector3d> body;  // a person: 0.4 x 0.5 x 1.75 m, two faces seen
+  for (int i = 0; i < 8; ++i) {
+    const double z = -0.85 + 0.24 * i;
+    for (int j = 0; j < 5; ++j) body.emplace_back(-0.2 + 0.1 * j, 0.25, z + 0.01 * j);  // front
+    for (int j = 0; j < 3; ++j) body.emplace_back(0.2, 0.1 * j, z + 0.02 * j);          // side
+  }
+  std::vector<Eigen::Vector3d> points = body;
+  for (int i = 0; i < 6; ++i) points.emplace_back(-0.4 - 0.14 * i, 0.3 + 0.03 * i, 0.3 + 0.05 * i);
+  ASSERT_EQ(CompactPoints(points, 4.0).size(), points.size());
+  ASSERT_EQ(LargestCluster(points, 3.0).size(), points.size());
+  const std::vector<Eigen::Vector3d> kept = AxisCompactPoints(points, 3.0, 0.25);
+  ASSERT_EQ(kept.size(), body.size());
+  for (size_t i = 0; i < body.size(); ++i) EXPECT_EQ(kept[i], body[i]);  // the body, in order
+  EXPECT_EQ(AxisCompactPoints(points, 0.0, 0.25).size(), points.size());  // 0: everything
+  const std::vector<Eigen::Vector3d> few(points.end() - 7, points.end());
+  EXPECT_EQ(AxisCompactPoints(few, 3.0, 0.25).size(), few.size());  // too few to tell
+  // Most points on one face: the depth axis deviates little, and without the floor the
+  // other face's points would go.
+  EXPECT_EQ(AxisCompactPoints(body, 3.0, 0.25).size(), body.size());
+  EXPECT_LT(AxisCompactPoints(body, 3.0, 0.01).size(), body.size());
+}
+
 // The largest cluster of published points: a group of another body's points beside the
 // object (a car passing behind a person walking the same way is triangulated as a
 // consistent group), which compactness keeps, is left out; the object's points stay
