@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <unordered_map>
 #include <utility>
@@ -69,13 +70,22 @@ std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& 
   return kept;
 }
 
-std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& points, double max_spread) {
-  if (max_spread <= 0.0 || points.size() < 8) return points;
+namespace {
+
+// The per-coordinate median of the points.
+Eigen::Vector3d MedianCentre(const std::vector<Eigen::Vector3d>& points) {
   std::vector<double> coords[3];
   for (const Eigen::Vector3d& p : points) {
     for (int a = 0; a < 3; ++a) coords[a].push_back(p[a]);
   }
-  const Eigen::Vector3d centre(Median(coords[0]), Median(coords[1]), Median(coords[2]));
+  return Eigen::Vector3d(Median(coords[0]), Median(coords[1]), Median(coords[2]));
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& points, double max_spread) {
+  if (max_spread <= 0.0 || points.size() < 8) return points;
+  const Eigen::Vector3d centre = MedianCentre(points);
   std::vector<double> distances;
   distances.reserve(points.size());
   for (const Eigen::Vector3d& p : points) distances.push_back((p - centre).norm());
@@ -88,28 +98,28 @@ std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& p
   return kept;
 }
 
-std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d>& points, double max_mads,
+std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d>& in, double max_mads,
                                                double min_mad_share) {
-  if (max_mads <= 0.0 || points.size() < 8) return points;
-  std::vector<double> coords[3];
-  for (const Eigen::Vector3d& p : points) {
-    for (int a = 0; a < 3; ++a) coords[a].push_back(p[a]);
+  if (max_mads <= 0.0 || in.size() < 8) return in;
+  std::vector<Eigen::Vector3d> points;  // a non-finite point is never published
+  points.reserve(in.size());
+  for (const Eigen::Vector3d& p : in) {
+    if (p.allFinite()) points.push_back(p);
   }
-  const Eigen::Vector3d centre(Median(coords[0]), Median(coords[1]), Median(coords[2]));
+  if (points.size() < 8) return points;
+  const Eigen::Vector3d centre = MedianCentre(points);
   // The body's axes from its inner half (points within the median distance of the centre):
   // the outliers this is for would tilt them.
   std::vector<double> distances;
+  distances.reserve(points.size());
   for (const Eigen::Vector3d& p : points) distances.push_back((p - centre).norm());
   const double inner = Median(distances);
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  int n_inner = 0;
   for (const Eigen::Vector3d& p : points) {
-    if ((p - centre).norm() > inner) continue;
-    cov += (p - centre) * (p - centre).transpose();
-    ++n_inner;
+    if ((p - centre).norm() <= inner) cov += (p - centre) * (p - centre).transpose();
   }
-  if (n_inner < 4) return points;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  if (eig.info() != Eigen::Success) return points;
   const Eigen::Matrix3d axes = eig.eigenvectors();  // columns
   Eigen::Vector3d med, mad;
   for (int a = 0; a < 3; ++a) {
@@ -119,10 +129,11 @@ std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d
     for (double x : proj) dev.push_back(std::abs(x - med[a]));
     mad[a] = Median(dev);
   }
+  // Half the points or more at one place: no spread to measure by.
+  if (!(mad.maxCoeff() > 0.0)) return points;
   // A side the tracks barely cover (points mostly on one face) has a small deviation:
   // it is floored at a share of the largest one.
   const double floor = min_mad_share * mad.maxCoeff();
-  if (!(floor > 0.0)) return points;
   std::vector<Eigen::Vector3d> kept;
   kept.reserve(points.size());
   for (const Eigen::Vector3d& p : points) {
@@ -132,6 +143,8 @@ std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d
     }
     if (inside) kept.push_back(p);
   }
+  // Only a minority is left out (as LargestCluster): else there is no body to measure by.
+  if (2 * kept.size() < points.size()) return points;
   return kept;
 }
 

@@ -134,7 +134,7 @@ struct ObjectReconstructionOptions {
     MBSLAM_CHECK_OPTION(max_point_spread == 0.0 || max_point_spread > 1.0);
     MBSLAM_CHECK_OPTION_GE(min_point_keyframes, 1);
     MBSLAM_CHECK_OPTION(cluster_link_factor == 0.0 || cluster_link_factor >= 1.0);
-    MBSLAM_CHECK_OPTION_GE(max_axis_mads, 0.0);
+    MBSLAM_CHECK_OPTION(max_axis_mads == 0.0 || max_axis_mads >= 1.0);
     MBSLAM_CHECK_OPTION(min_axis_mad_share > 0.0 && min_axis_mad_share <= 1.0);
     MBSLAM_CHECK_OPTION_GE(rotation_prior_floor_rad, 0.0);
     MBSLAM_CHECK_OPTION_GE(rotation_prior_rad_per_s, 0.0);
@@ -215,7 +215,8 @@ std::vector<Eigen::Vector3d> MaturePoints(const Map& map, int min_keyframes);
 std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& points, double link_factor);
 // The points within max_mads median absolute deviations of the median along each
 // principal axis of the inner half (deviations floored at min_mad_share of the largest);
-// fewer than 8 points or max_mads 0: all.
+// non-finite points are left out. Fewer than 8 points or max_mads 0: all; half the
+// points or more at one place (no spread), or a majority outside: all finite ones.
 std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d>& points, double max_mads,
                                                double min_mad_share);
 

@@ -157,14 +157,20 @@ TEST(ObjectReconstructionTest, PublishedPointsLeaveOutPointsFarOutsideTheBody) {
 // its points lay in a chain off the person's thin side, 0.4-1.1 m from a body 0.4 m wide,
 // which neither the radius about the median nor the clusters leave out.
 TEST(ObjectReconstructionTest, PublishedPointsStayWithinTheBodysAxes) {
+  // The map's axes are arbitrary: the body is turned off them (world axes would not do).
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitX()) *
+                             Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())).toRotationMatrix();
+  const Eigen::Vector3d offset(1.0, -2.0, 6.0);
+  auto place = [&](double x, double y, double z) { return Eigen::Vector3d(R * Eigen::Vector3d(x, y, z) + offset); };
   std::vector<Eigen::Vector3d> body;  // a person: 0.4 x 0.5 x 1.75 m, two faces seen
   for (int i = 0; i < 8; ++i) {
     const double z = -0.85 + 0.24 * i;
-    for (int j = 0; j < 5; ++j) body.emplace_back(-0.2 + 0.1 * j, 0.25, z + 0.01 * j);  // front
-    for (int j = 0; j < 3; ++j) body.emplace_back(0.2, 0.1 * j, z + 0.02 * j);          // side
+    for (int j = 0; j < 5; ++j) body.push_back(place(-0.2 + 0.1 * j, 0.25, z + 0.01 * j));  // front
+    for (int j = 0; j < 3; ++j) body.push_back(place(0.2, 0.1 * j, z + 0.02 * j));          // side
   }
   std::vector<Eigen::Vector3d> points = body;
-  for (int i = 0; i < 6; ++i) points.emplace_back(-0.4 - 0.14 * i, 0.3 + 0.03 * i, 0.3 + 0.05 * i);
+  for (int i = 0; i < 6; ++i) points.push_back(place(-0.4 - 0.14 * i, 0.3 + 0.03 * i, 0.3 + 0.05 * i));
   ASSERT_EQ(CompactPoints(points, 4.0).size(), points.size());
   ASSERT_EQ(LargestCluster(points, 3.0).size(), points.size());
   const std::vector<Eigen::Vector3d> kept = AxisCompactPoints(points, 3.0, 0.25);
@@ -173,10 +179,22 @@ TEST(ObjectReconstructionTest, PublishedPointsStayWithinTheBodysAxes) {
   EXPECT_EQ(AxisCompactPoints(points, 0.0, 0.25).size(), points.size());  // 0: everything
   const std::vector<Eigen::Vector3d> few(points.end() - 7, points.end());
   EXPECT_EQ(AxisCompactPoints(few, 3.0, 0.25).size(), few.size());  // too few to tell
+  // A non-finite point is never published, and does not switch the filter off.
+  std::vector<Eigen::Vector3d> with_nan = points;
+  with_nan.insert(with_nan.begin() + 3, Eigen::Vector3d(std::nan(""), 0.0, 0.0));
+  EXPECT_EQ(AxisCompactPoints(with_nan, 3.0, 0.25).size(), body.size());
   // Most points on one face: the depth axis deviates little, and without the floor the
-  // other face's points would go.
+  // other face's points would go (the body as it is, then on the map's axes, where its
+  // face normal is an axis exactly).
   EXPECT_EQ(AxisCompactPoints(body, 3.0, 0.25).size(), body.size());
-  EXPECT_LT(AxisCompactPoints(body, 3.0, 0.01).size(), body.size());
+  std::vector<Eigen::Vector3d> aligned;
+  for (const Eigen::Vector3d& p : body) aligned.push_back(R.transpose() * (p - offset));
+  EXPECT_EQ(AxisCompactPoints(aligned, 3.0, 0.25).size(), aligned.size());
+  EXPECT_LT(AxisCompactPoints(aligned, 3.0, 0.01).size(), aligned.size());
+  // Half the points or more at one place: no spread to measure by, all are kept.
+  std::vector<Eigen::Vector3d> stacked(10, offset);
+  for (int i = 0; i < 6; ++i) stacked.push_back(place(0.1 * i, 0.0, 0.0));
+  EXPECT_EQ(AxisCompactPoints(stacked, 3.0, 0.25).size(), stacked.size());
 }
 
 // The largest cluster of published points: a group of another body's points beside the
