@@ -115,8 +115,8 @@ std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d
   for (const Eigen::Vector3d& p : points) distances.push_back((p - centre).norm());
   const double inner = Median(distances);
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3d& p : points) {
-    if ((p - centre).norm() <= inner) cov += (p - centre) * (p - centre).transpose();
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (distances[i] <= inner) cov += (points[i] - centre) * (points[i] - centre).transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
   if (eig.info() != Eigen::Success) return points;
