@@ -938,6 +938,7 @@ void Usage() {
   reconstructions  moving objects' own reconstructions (result/reconstructions/): camera-relative
            trajectory and shape (point-to-box distance) after a similarity, per body
            --dir DIR --gt-log LOG [--min-samples 10] [--max-dt-us N]
+           (env EVAL_DUMP_SHAPE=1: each scored point in its body's frame and its distance, to stderr)
   points   reconstruction accuracy / completeness against ground-truth surface points
            --est XYZ --gt XYZ (e.g. <sequence>/points/<id>.txt) [--threshold 0.05] [--max-distance 1.0]
   perturb  write a trajectory with a known similarity and noise (expected ATE printed)

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 #include "tools/eval/alignment.h"
@@ -40,6 +42,7 @@ Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<
                               ReconstructionResult* result) {
   bool found = false;
   double best = std::numeric_limits<double>::infinity();
+  std::vector<Eigen::Vector3d> best_points;  // the best body's frame
   for (const auto& [id, body] : truth) {
     std::vector<Rigid3d> src, dst;
     for (const TimedPose& e : est.obj_from_cam) {
@@ -80,8 +83,10 @@ Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<
     r.size_m = body.extent.maxCoeff();
     std::vector<double> d;
     int within = 0;
+    best_points.clear();
     for (const Eigen::Vector3d& p : est.points) {
-      d.push_back(BoxSurfaceDistance(body_from_map * p, body.extent));
+      best_points.push_back(body_from_map * p);
+      d.push_back(BoxSurfaceDistance(best_points.back(), body.extent));
       within += d.back() <= 0.02 * r.size_m;
     }
     r.num_points = static_cast<int>(d.size());
@@ -92,6 +97,14 @@ Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<
       r.shape_err_rel_median = r.shape_median_m / r.size_m;
     }
     r.share_within_2pct = d.empty() ? 0.0 : static_cast<double>(within) / static_cast<double>(d.size());
+  }
+  if (found && std::getenv("EVAL_DUMP_SHAPE")) {
+    // Each scored point in the body's frame with its distance to the body's surface.
+    for (const Eigen::Vector3d& q : best_points) {
+      std::fprintf(stderr, "SHAPE object %d map %lld body %d point %.3f %.3f %.3f distance %.3f\n", result->object_id,
+                   static_cast<long long>(result->map_id), result->gt_id, q.x(), q.y(), q.z(),
+                   BoxSurfaceDistance(q, truth.at(result->gt_id).extent));
+    }
   }
   if (!found) return Status::Error("reconstruction of object " + std::to_string(est.object_id) + " map " +
                                    std::to_string(est.map_id) + ": no body with enough common samples");

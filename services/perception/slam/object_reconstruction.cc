@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <unordered_map>
 #include <utility>
 
@@ -14,18 +15,51 @@
 namespace mbslam {
 
 std::vector<Eigen::Vector3d> MaturePoints(const Map& map, int min_keyframes) {
-  const size_t need = std::min(static_cast<size_t>(std::max(1, min_keyframes)), map.num_keyframes());
   std::vector<Eigen::Vector3d> out;
+  for (int64_t pid : MaturePointIds(map, min_keyframes)) out.push_back(map.point(pid)->position);
+  return out;
+}
+
+std::vector<int64_t> MaturePointIds(const Map& map, int min_keyframes) {
+  const size_t need = std::min(static_cast<size_t>(std::max(1, min_keyframes)), map.num_keyframes());
+  std::vector<int64_t> out;
   out.reserve(map.num_points());
   for (const auto& [pid, p] : map.points()) {
-    if (p.observations.size() >= need) out.push_back(p.position);
+    if (p.observations.size() >= need) out.push_back(pid);
   }
   return out;
 }
 
-std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& points, double link_factor) {
+namespace {
+
+std::vector<size_t> AllIndices(size_t n) {
+  std::vector<size_t> all(n);
+  std::iota(all.begin(), all.end(), 0);
+  return all;
+}
+
+template <typename T>
+std::vector<T> Select(const std::vector<T>& items, const std::vector<size_t>& indices) {
+  std::vector<T> out;
+  out.reserve(indices.size());
+  for (size_t i : indices) out.push_back(items[i]);
+  return out;
+}
+
+// The per-coordinate median of the points.
+Eigen::Vector3d MedianCentre(const std::vector<Eigen::Vector3d>& points) {
+  std::vector<double> coords[3];
+  for (const Eigen::Vector3d& p : points) {
+    for (int a = 0; a < 3; ++a) coords[a].push_back(p[a]);
+  }
+  return Eigen::Vector3d(Median(coords[0]), Median(coords[1]), Median(coords[2]));
+}
+
+}  // namespace
+
+std::vector<size_t> LargestClusterIndices(const std::vector<Eigen::Vector3d>& points, double link_factor) {
   const size_t n = points.size();
-  if (link_factor <= 0.0 || n < 8) return points;
+  if (link_factor <= 0.0 || n < 8) return AllIndices(n);
   std::vector<double> nearest(n, std::numeric_limits<double>::infinity());
   for (size_t i = 0; i < n; ++i) {
     for (size_t j = i + 1; j < n; ++j) {
@@ -35,7 +69,7 @@ std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& 
     }
   }
   const double link = link_factor * Median(nearest);
-  if (!(link > 0.0)) return points;  // half the points or more duplicated: no scale to link by
+  if (!(link > 0.0)) return AllIndices(n);  // half the points or more duplicated: no scale to link by
   // Connected components under links of at most `link` (depth-first).
   std::vector<int> component(n, -1);
   std::vector<size_t> sizes;
@@ -61,52 +95,48 @@ std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& 
   const int largest = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
   // Only a minority is left out: without a cluster of most points there is no body to
   // tell apart from the rest.
-  if (2 * sizes[static_cast<size_t>(largest)] < n) return points;
-  std::vector<Eigen::Vector3d> kept;
+  if (2 * sizes[static_cast<size_t>(largest)] < n) return AllIndices(n);
+  std::vector<size_t> kept;
   kept.reserve(sizes[static_cast<size_t>(largest)]);
   for (size_t i = 0; i < n; ++i) {
-    if (component[i] == largest) kept.push_back(points[i]);
+    if (component[i] == largest) kept.push_back(i);
   }
   return kept;
 }
 
-namespace {
-
-// The per-coordinate median of the points.
-Eigen::Vector3d MedianCentre(const std::vector<Eigen::Vector3d>& points) {
-  std::vector<double> coords[3];
-  for (const Eigen::Vector3d& p : points) {
-    for (int a = 0; a < 3; ++a) coords[a].push_back(p[a]);
-  }
-  return Eigen::Vector3d(Median(coords[0]), Median(coords[1]), Median(coords[2]));
+std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& points, double link_factor) {
+  return Select(points, LargestClusterIndices(points, link_factor));
 }
 
-}  // namespace
-
-std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& points, double max_spread) {
-  if (max_spread <= 0.0 || points.size() < 8) return points;
+std::vector<size_t> CompactIndices(const std::vector<Eigen::Vector3d>& points, double max_spread) {
+  if (max_spread <= 0.0 || points.size() < 8) return AllIndices(points.size());
   const Eigen::Vector3d centre = MedianCentre(points);
   std::vector<double> distances;
   distances.reserve(points.size());
   for (const Eigen::Vector3d& p : points) distances.push_back((p - centre).norm());
   const double limit = max_spread * Median(distances);
-  std::vector<Eigen::Vector3d> kept;
+  std::vector<size_t> kept;
   kept.reserve(points.size());
-  for (const Eigen::Vector3d& p : points) {
-    if ((p - centre).norm() <= limit) kept.push_back(p);
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (distances[i] <= limit) kept.push_back(i);
   }
   return kept;
 }
 
-std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d>& in, double max_mads,
-                                               double min_mad_share) {
-  if (max_mads <= 0.0 || in.size() < 8) return in;
-  std::vector<Eigen::Vector3d> points;  // a non-finite point is never published
-  points.reserve(in.size());
-  for (const Eigen::Vector3d& p : in) {
-    if (p.allFinite()) points.push_back(p);
+std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& points, double max_spread) {
+  return Select(points, CompactIndices(points, max_spread));
+}
+
+std::vector<size_t> AxisCompactIndices(const std::vector<Eigen::Vector3d>& in, double max_mads,
+                                       double min_mad_share) {
+  if (max_mads <= 0.0 || in.size() < 8) return AllIndices(in.size());
+  std::vector<size_t> finite;  // a non-finite point is never published
+  finite.reserve(in.size());
+  for (size_t i = 0; i < in.size(); ++i) {
+    if (in[i].allFinite()) finite.push_back(i);
   }
-  if (points.size() < 8) return points;
+  if (finite.size() < 8) return finite;
+  const std::vector<Eigen::Vector3d> points = Select(in, finite);
   const Eigen::Vector3d centre = MedianCentre(points);
   // The body's axes from its inner half (points within the median distance of the centre):
   // the outliers this is for would tilt them.
@@ -119,7 +149,7 @@ std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d
     if (distances[i] <= inner) cov += (points[i] - centre) * (points[i] - centre).transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  if (eig.info() != Eigen::Success) return points;
+  if (eig.info() != Eigen::Success) return finite;
   const Eigen::Matrix3d axes = eig.eigenvectors();  // columns
   Eigen::Vector3d med, mad;
   for (int a = 0; a < 3; ++a) {
@@ -130,22 +160,43 @@ std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d
     mad[a] = Median(dev);
   }
   // Half the points or more at one place: no spread to measure by.
-  if (!(mad.maxCoeff() > 0.0)) return points;
+  if (!(mad.maxCoeff() > 0.0)) return finite;
   // A side the tracks barely cover (points mostly on one face) has a small deviation:
   // it is floored at a share of the largest one.
   const double floor = min_mad_share * mad.maxCoeff();
-  std::vector<Eigen::Vector3d> kept;
+  std::vector<size_t> kept;
   kept.reserve(points.size());
-  for (const Eigen::Vector3d& p : points) {
+  for (size_t i = 0; i < points.size(); ++i) {
     bool inside = true;
     for (int a = 0; a < 3 && inside; ++a) {
-      inside = std::abs(axes.col(a).dot(p - centre) - med[a]) <= max_mads * std::max(mad[a], floor);
+      inside = std::abs(axes.col(a).dot(points[i] - centre) - med[a]) <= max_mads * std::max(mad[a], floor);
     }
-    if (inside) kept.push_back(p);
+    if (inside) kept.push_back(finite[i]);
   }
   // Only a minority is left out (as LargestCluster): else there is no body to measure by.
-  if (2 * kept.size() < points.size()) return points;
+  if (2 * kept.size() < points.size()) return finite;
   return kept;
+}
+
+std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d>& in, double max_mads,
+                                               double min_mad_share) {
+  return Select(in, AxisCompactIndices(in, max_mads, min_mad_share));
+}
+
+std::vector<int64_t> BodyPointIds(const Map& map, const ObjectReconstructionOptions& options) {
+  std::vector<int64_t> ids = MaturePointIds(map, options.min_point_keyframes);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(ids.size());
+  for (int64_t pid : ids) points.push_back(map.point(pid)->position);
+  // Each filter works on what the previous one kept.
+  auto apply = [&](const std::vector<size_t>& kept) {
+    ids = Select(ids, kept);
+    points = Select(points, kept);
+  };
+  apply(CompactIndices(points, options.max_point_spread));
+  apply(LargestClusterIndices(points, options.cluster_link_factor));
+  apply(AxisCompactIndices(points, options.max_axis_mads, options.min_axis_mad_share));
+  return ids;
 }
 
 SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOptions& options,
@@ -290,11 +341,9 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
       if (update.new_keyframe || e.last_points_frame < 0 ||
           frame_index - e.last_points_frame >= options_.points_every_frames) {
         r.points_included = true;
-        r.points = AxisCompactPoints(
-            LargestCluster(CompactPoints(MaturePoints(e.slam->map(), options_.min_point_keyframes),
-                                         options_.max_point_spread),
-                           options_.cluster_link_factor),
-            options_.max_axis_mads, options_.min_axis_mad_share);
+        for (int64_t pid : BodyPointIds(e.slam->map(), options_)) {
+          r.points.push_back(e.slam->map().point(pid)->position);
+        }
         e.last_points_frame = frame_index;
       }
     }

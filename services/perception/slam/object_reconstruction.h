@@ -219,6 +219,17 @@ std::vector<Eigen::Vector3d> LargestCluster(const std::vector<Eigen::Vector3d>& 
 // points or more at one place (no spread), or a majority outside: all finite ones.
 std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d>& points, double max_mads,
                                                double min_mad_share);
+// The same three filters as indices into `points` (ascending).
+std::vector<size_t> CompactIndices(const std::vector<Eigen::Vector3d>& points, double max_spread);
+std::vector<size_t> LargestClusterIndices(const std::vector<Eigen::Vector3d>& points, double link_factor);
+std::vector<size_t> AxisCompactIndices(const std::vector<Eigen::Vector3d>& points, double max_mads,
+                                       double min_mad_share);
+// MaturePoints as map point ids.
+std::vector<int64_t> MaturePointIds(const Map& map, int min_keyframes);
+// The ids of the map's points taken for the body, its published points: mature
+// (min_point_keyframes), then compact (max_point_spread), then the largest cluster
+// (cluster_link_factor), then within the body's axes (max_axis_mads).
+std::vector<int64_t> BodyPointIds(const Map& map, const ObjectReconstructionOptions& options);
 
 class ObjectReconstruction {
  public:

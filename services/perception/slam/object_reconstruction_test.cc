@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <set>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -396,6 +398,52 @@ TEST(ObjectReconstructionTest, MaturePointsNeedThreeKeyframesOnceThereAreThree) 
   EXPECT_EQ(pts[0].x(), 3.0);
   EXPECT_EQ(MaturePoints(map, 1).size(), 3u);
   EXPECT_EQ(MaturePoints(map, 2).size(), 2u);
+}
+
+// The published points' ids: mature points of the body, without those off it (each
+// filter on what the previous one kept; the same points the filters give one by one).
+TEST(ObjectReconstructionTest, BodyPointIdsAreTheMaturePointsOnTheBody) {
+  Map map;
+  std::vector<int64_t> kf;
+  for (int k = 0; k < 3; ++k) kf.push_back(map.AddKeyframe(Keyframe()));
+  auto add_point = [&](const Eigen::Vector3d& x, int views) {
+    MapPoint p;
+    p.position = x;
+    const int64_t id = map.AddPoint(p);
+    for (int v = 0; v < views; ++v) map.AddObservation(id, kf[static_cast<size_t>(v)], Eigen::Vector2d::Zero());
+    return id;
+  };
+  // A 0.4 x 0.5 x 1.75 box's surface, sampled on a grid, seen from all three keyframes.
+  std::vector<int64_t> body;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      const double y = -0.25 + 0.1 * i, z = -0.875 + 0.35 * j;
+      body.push_back(add_point(Eigen::Vector3d(0.2, y, z), 3));
+      body.push_back(add_point(Eigen::Vector3d(-0.2, y, z), 3));
+    }
+  }
+  const int64_t young = add_point(Eigen::Vector3d(0.0, 0.0, 0.0), 2);  // two views: not mature
+  const int64_t far = add_point(Eigen::Vector3d(0.2, 0.0, 8.0), 3);    // far off the body
+  const int64_t beside = add_point(Eigen::Vector3d(1.2, 0.05, 0.0), 3);  // off its thin side
+  ObjectReconstructionOptions options;
+  options.min_point_keyframes = 3;
+  const std::vector<int64_t> ids = BodyPointIds(map, options);
+  const std::set<int64_t> kept(ids.begin(), ids.end());
+  EXPECT_EQ(kept.size(), ids.size());
+  for (int64_t id : body) EXPECT_TRUE(kept.count(id)) << id;
+  EXPECT_FALSE(kept.count(young));
+  EXPECT_FALSE(kept.count(far));
+  EXPECT_FALSE(kept.count(beside));
+  // The same as the filters one by one on the mature points.
+  const std::vector<Eigen::Vector3d> chained = AxisCompactPoints(
+      LargestCluster(CompactPoints(MaturePoints(map, 3), options.max_point_spread), options.cluster_link_factor),
+      options.max_axis_mads, options.min_axis_mad_share);
+  EXPECT_EQ(chained.size(), ids.size());
+  // Filters off: every mature point.
+  options.max_point_spread = 0.0;
+  options.cluster_link_factor = 0.0;
+  options.max_axis_mads = 0.0;
+  EXPECT_EQ(BodyPointIds(map, options).size(), body.size() + 2);
 }
 
 }  // namespace
