@@ -27,6 +27,7 @@
 
 #include "common/lcm/channels.h"
 #include "common/util/atomic_file.h"
+#include "common/util/command_line.h"
 #include "tools/eval/camera_metrics.h"
 #include "tools/eval/datasets.h"
 #include "tools/eval/json.h"
@@ -45,66 +46,12 @@ namespace eval = mbslam::eval;
 namespace fs = std::filesystem;
 using eval::Json;
 
-// --key value arguments (and bare --flags) after the subcommand.
-class Args {
- public:
-  Args(int argc, char** argv, int first) {
-    for (int i = first; i < argc; ++i) {
-      std::string a = argv[i];
-      if (a.rfind("--", 0) != 0) {
-        bad_ = "unexpected argument '" + a + "'";
-        return;
-      }
-      a = a.substr(2);
-      if (i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0) {
-        values_[a] = argv[++i];
-      } else {
-        values_[a] = "";
-      }
-    }
-  }
-  bool Has(const std::string& key) const {
-    used_.insert(key);
-    return values_.count(key) > 0;
-  }
-  std::string Get(const std::string& key, const std::string& fallback = "") const {
-    used_.insert(key);
-    auto it = values_.find(key);
-    return it == values_.end() ? fallback : it->second;
-  }
-  double GetDouble(const std::string& key, double fallback) const {
-    const std::string v = Get(key);
-    return v.empty() ? fallback : std::atof(v.c_str());
-  }
-  int64_t GetInt(const std::string& key, int64_t fallback) const {
-    const std::string v = Get(key);
-    return v.empty() ? fallback : std::atoll(v.c_str());
-  }
-  // An error message for malformed or unknown arguments, empty if all is well.
-  std::string Problems() const {
-    if (!bad_.empty()) {
-      return bad_;
-    }
-    for (const auto& kv : values_) {
-      if (!used_.count(kv.first)) {
-        return "unknown option --" + kv.first;
-      }
-    }
-    return "";
-  }
-
- private:
-  std::map<std::string, std::string> values_;
-  mutable std::set<std::string> used_;
-  std::string bad_;
-};
-
 int Fail(const std::string& message) {
   std::cerr << "mbslam-eval: " << message << "\n";
   return 1;
 }
 
-int Finish(const Json& json, const Args& args) {
+int Finish(const Json& json, const mbslam::CommandLineArgs& args) {
   const bool write_json = args.Has("json");
   const std::string problems = args.Problems();
   if (!problems.empty()) {
@@ -138,7 +85,7 @@ bool ParseVector3(const std::string& text, Eigen::Vector3d* v) {
 
 // ---------------------------------------------------------------- ate
 
-Status LoadGroundTruthCamera(const Args& args, const mbslam::ChannelOptions& channels,
+Status LoadGroundTruthCamera(const mbslam::CommandLineArgs& args, const mbslam::ChannelOptions& channels,
                              eval::Trajectory* gt, std::string* description) {
   if (args.Has("gt")) {
     *description = args.Get("gt");
@@ -168,7 +115,7 @@ Status LoadGroundTruthCamera(const Args& args, const mbslam::ChannelOptions& cha
       "ate: give --gt FILE.tum, --gt-log LOG, --gt-sequence DIR or --gt-tartanair pose_left.txt");
 }
 
-int RunAte(const Args& args) {
+int RunAte(const mbslam::CommandLineArgs& args) {
   const mbslam::ChannelOptions channels;
   eval::Trajectory est, gt;
   std::string gt_description, est_description;
@@ -288,7 +235,7 @@ double Median(std::vector<double> v) {
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
 }
 
-int RunSeg(const Args& args) {
+int RunSeg(const mbslam::CommandLineArgs& args) {
   if (args.Has("pred") && args.Has("truth")) {
     std::vector<int> pred, truth;
     Status st = eval::ReadLabelFile(args.Get("pred"), &pred);
@@ -397,7 +344,7 @@ Status ReadFeatureFile(const std::string& path,
   return Status::Ok();
 }
 
-int RunMasks(const Args& args) {
+int RunMasks(const mbslam::CommandLineArgs& args) {
   const std::string pred_dir = args.Get("pred-dir"), gt_dir = args.Get("gt-dir");
   if (pred_dir.empty() || gt_dir.empty()) {
     return Fail("masks: give --pred-dir DIR --gt-dir DIR");
@@ -468,7 +415,7 @@ int RunMasks(const Args& args) {
 
 // ---------------------------------------------------------------- camvid
 
-int RunCamVid(const Args& args) {
+int RunCamVid(const mbslam::CommandLineArgs& args) {
   const std::string root = args.Get("root", eval::DataSetPath("camvid_0016E5_15hz"));
   if (root.empty()) {
     return Fail("camvid: no --root and no camvid_0016E5_15hz under " + eval::DataRoot());
@@ -514,7 +461,7 @@ int RunCamVid(const Args& args) {
 
 // ---------------------------------------------------------------- objects
 
-int RunObjects(const Args& args) {
+int RunObjects(const mbslam::CommandLineArgs& args) {
   const mbslam::ChannelOptions channels;
   if (!args.Has("est-log") || !args.Has("gt-log")) {
     return Fail("objects: give --est-log LOG --gt-log LOG");
@@ -660,7 +607,7 @@ int RunObjects(const Args& args) {
 
 // ---------------------------------------------------------------- reconstructions
 
-int RunReconstructions(const Args& args) {
+int RunReconstructions(const mbslam::CommandLineArgs& args) {
   const mbslam::ChannelOptions channels;
   if (!args.Has("dir") || !args.Has("gt-log")) {
     return Fail("reconstructions: give --dir RESULT/reconstructions --gt-log LOG");
@@ -730,7 +677,7 @@ int RunReconstructions(const Args& args) {
 
 // ---------------------------------------------------------------- points
 
-int RunPoints(const Args& args) {
+int RunPoints(const mbslam::CommandLineArgs& args) {
   if (!args.Has("est") || !args.Has("gt")) {
     return Fail("points: give --est XYZ --gt XYZ (same frame and units)");
   }
@@ -760,7 +707,7 @@ int RunPoints(const Args& args) {
 
 // ---------------------------------------------------------------- perturb
 
-int RunPerturb(const Args& args) {
+int RunPerturb(const mbslam::CommandLineArgs& args) {
   if (!args.Has("in") || !args.Has("out")) {
     return Fail("perturb: give --in GT.tum --out EST.tum");
   }
@@ -804,7 +751,7 @@ int RunPerturb(const Args& args) {
   return Finish(j, args);
 }
 
-int RunPerturbLabels(const Args& args) {
+int RunPerturbLabels(const mbslam::CommandLineArgs& args) {
   if (!args.Has("truth") || !args.Has("out")) {
     return Fail("perturb-labels: give --truth FILE --out FILE");
   }
@@ -839,7 +786,7 @@ int RunPerturbLabels(const Args& args) {
 
 // ---------------------------------------------------------------- datasets
 
-int RunDatasets(const Args& args) {
+int RunDatasets(const mbslam::CommandLineArgs& args) {
   Json j = Json::Object();
   j.Set("metric", "datasets").Set("root", eval::DataRoot());
   std::printf("data root: %s\n", eval::DataRoot().c_str());
@@ -958,7 +905,7 @@ static int Main(int argc, char** argv) {
     return argc < 2 ? 2 : 0;
   }
   const std::string cmd = argv[1];
-  const Args args(argc, argv, 2);
+  const mbslam::CommandLineArgs args(argc, argv, 2);
   if (cmd == "ate") {
     return RunAte(args);
   }

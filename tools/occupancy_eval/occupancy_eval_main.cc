@@ -14,6 +14,7 @@
 #include <string>
 
 #include "common/util/atomic_file.h"
+#include "common/util/command_line.h"
 #include "tools/eval/json.h"
 #include "tools/eval/trajectory.h"
 #include "tools/occupancy_eval/occupancy_eval.h"
@@ -37,90 +38,26 @@ constexpr char kUsage[] =
     "  --frame-step  use every N-th frame (default 1)\n"
     "  --all-frames  also frames outside the estimated trajectory's time span\n";
 
-// --key value arguments and bare --flags.
-class Args {
- public:
-  Args(int argc, char** argv) {
-    for (int i = 1; i < argc; ++i) {
-      std::string a = argv[i];
-      if (a.rfind("--", 0) != 0) {
-        bad_ = "unexpected argument '" + a + "'";
-        return;
-      }
-      a = a.substr(2);
-      if (i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0) {
-        values_[a] = argv[++i];
-      } else {
-        values_[a] = "";
-      }
-    }
-  }
-  bool Has(const std::string& key) const {
-    used_.insert(key);
-    return values_.count(key) > 0;
-  }
-  std::string Get(const std::string& key, const std::string& fallback = "") const {
-    used_.insert(key);
-    auto it = values_.find(key);
-    return it == values_.end() ? fallback : it->second;
-  }
-  // False (and a message) if the value is not a number.
-  bool GetDouble(const std::string& key, double* value, std::string* error) const {
-    const std::string v = Get(key);
-    if (v.empty()) {
-      return true;
-    }
-    char* end = nullptr;
-    *value = std::strtod(v.c_str(), &end);
-    if (end == v.c_str() || *end != '\0') {
-      *error = "--" + key + " expects a number, got '" + v + "'";
-      return false;
-    }
-    return true;
-  }
-  std::string Problems() const {
-    if (!bad_.empty()) {
-      return bad_;
-    }
-    for (const auto& kv : values_) {
-      if (!used_.count(kv.first)) {
-        return "unknown option --" + kv.first;
-      }
-    }
-    return "";
-  }
-
- private:
-  std::map<std::string, std::string> values_;
-  mutable std::set<std::string> used_;
-  std::string bad_;
-};
-
 int Fail(const std::string& message) {
   std::cerr << "mbslam-eval-occupancy: " << message << "\n";
   return 1;
 }
 
 int Run(int argc, char** argv) {
-  const Args args(argc, argv);
+  const mbslam::CommandLineArgs args(argc, argv);
   if (args.Has("help") || argc == 1) {
     std::cout << kUsage;
     return argc == 1 ? 1 : 0;
   }
   eval::OccupancyEvalOptions options;
-  std::string error;
-  double pixel_step = options.pixel_step, frame_step = options.frame_step;
-  double max_dt = static_cast<double>(options.max_time_diff_us);
-  if (!args.GetDouble("resolution", &options.resolution_m, &error) ||
-      !args.GetDouble("max-range", &options.max_range_m, &error) ||
-      !args.GetDouble("pixel-step", &pixel_step, &error) ||
-      !args.GetDouble("frame-step", &frame_step, &error) ||
-      !args.GetDouble("max-dt-us", &max_dt, &error)) {
-    return Fail(error);
-  }
+  options.resolution_m = args.GetDouble("resolution", options.resolution_m);
+  options.max_range_m = args.GetDouble("max-range", options.max_range_m);
+  const int64_t pixel_step = args.GetInt("pixel-step", options.pixel_step);
+  const int64_t frame_step = args.GetInt("frame-step", options.frame_step);
+  const int64_t max_dt = args.GetInt("max-dt-us", options.max_time_diff_us);
   options.pixel_step = static_cast<int>(pixel_step);
   options.frame_step = static_cast<int>(frame_step);
-  options.max_time_diff_us = static_cast<int64_t>(max_dt);
+  options.max_time_diff_us = max_dt;
   options.all_frames = args.Has("all-frames");
   options.alignment = args.Get("align", options.alignment);
   const std::string bt = args.Get("bt");

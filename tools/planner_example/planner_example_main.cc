@@ -25,6 +25,7 @@
 #include "common/config/options_yaml.h"
 #include "common/lcm/channels.h"
 #include "common/lcm/lcm_bus.h"
+#include "common/util/command_line.h"
 #include "common/lcm/wire_check.h"
 #include "common/util/atomic_file.h"
 #include "common/util/shutdown.h"
@@ -68,64 +69,6 @@ constexpr char kUsage[] =
     "  --wait           live: seconds to wait for the first messages (default 3)\n"
     "  --require-metric refuse a world that is only up to scale\n"
     "exit status: 0 free, 1 blocked, 2 no perception data or bad input\n";
-
-class Args {
- public:
-  Args(int argc, char** argv) {
-    for (int i = 1; i < argc; ++i) {
-      std::string a = argv[i];
-      if (a.rfind("--", 0) != 0) {
-        bad_ = "unexpected argument '" + a + "'";
-        return;
-      }
-      a = a.substr(2);
-      if (i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0) {
-        values_[a] = argv[++i];
-      } else {
-        values_[a] = "";
-      }
-    }
-  }
-  bool Has(const std::string& key) const {
-    used_.insert(key);
-    return values_.count(key) > 0;
-  }
-  std::string Get(const std::string& key, const std::string& fallback = "") const {
-    used_.insert(key);
-    auto it = values_.find(key);
-    return it == values_.end() ? fallback : it->second;
-  }
-  bool GetDouble(const std::string& key, double* value) {
-    const std::string v = Get(key);
-    if (v.empty()) {
-      return true;
-    }
-    char* end = nullptr;
-    const double d = std::strtod(v.c_str(), &end);
-    if (end == v.c_str() || *end != '\0') {
-      bad_ = "--" + key + " expects a number, got '" + v + "'";
-      return false;
-    }
-    *value = d;
-    return true;
-  }
-  std::string Problems() const {
-    if (!bad_.empty()) {
-      return bad_;
-    }
-    for (const auto& kv : values_) {
-      if (!used_.count(kv.first)) {
-        return "unknown option --" + kv.first;
-      }
-    }
-    return "";
-  }
-
- private:
-  std::map<std::string, std::string> values_;
-  mutable std::set<std::string> used_;
-  std::string bad_;
-};
 
 // The latest perception outputs, decoded.
 struct PerceptionState {
@@ -253,18 +196,18 @@ int Answer(const PerceptionState& state, const planner::PathCheckOptions& option
 }
 
 int Run(int argc, char** argv) {
-  Args args(argc, argv);
+  const mbslam::CommandLineArgs args(argc, argv);
   if (argc == 1 || args.Has("help")) {
     std::cout << kUsage;
     return argc == 1 ? kExitNoAnswer : kExitFree;
   }
   planner::PathCheckOptions options;
   double period_s = 0.5, wait_s = 3.0;
-  args.GetDouble("robot-radius", &options.robot_radius);
-  args.GetDouble("horizon", &options.horizon_s);
-  args.GetDouble("min-probability", &options.min_volume_probability);
-  args.GetDouble("period", &period_s);
-  args.GetDouble("wait", &wait_s);
+  options.robot_radius = args.GetDouble("robot-radius", options.robot_radius);
+  options.horizon_s = args.GetDouble("horizon", options.horizon_s);
+  options.min_volume_probability = args.GetDouble("min-probability", options.min_volume_probability);
+  period_s = args.GetDouble("period", period_s);
+  wait_s = args.GetDouble("wait", wait_s);
   options.unknown_is_occupied = args.Has("unknown-is-occupied");
   options.hold_last_waypoint = !args.Has("no-hold");
   const bool watch = args.Has("watch");

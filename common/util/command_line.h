@@ -1,0 +1,40 @@
+#ifndef MBSLAM_COMMON_UTIL_COMMAND_LINE_H_
+#define MBSLAM_COMMON_UTIL_COMMAND_LINE_H_
+
+#include <cstdint>
+#include <map>
+#include <set>
+#include <string>
+
+namespace mbslam {
+
+// The command line of the project's tools: `--key value` pairs and bare `--flag`s (a
+// flag is followed by another `--key` or by nothing; a value may start with a single
+// '-', e.g. a negative number). Every key read is remembered: Problems() then names the
+// first argument that is not an option, the first number that does not parse, or the
+// first option no one asked for.
+class CommandLineArgs {
+ public:
+  // Arguments argv[first] ... argv[argc - 1] (a subcommand before them is the caller's).
+  CommandLineArgs(int argc, const char* const* argv, int first = 1);
+
+  bool Has(const std::string& key) const;
+  // The value ("" for a bare flag), or `fallback` when the option is absent.
+  std::string Get(const std::string& key, const std::string& fallback = "") const;
+  // The value as a number, or `fallback` when absent; a value that is not all a number
+  // (trailing text, empty, out of range) also gives `fallback` and is a problem.
+  double GetDouble(const std::string& key, double fallback) const;
+  int64_t GetInt(const std::string& key, int64_t fallback) const;
+  // The first problem with the command line ("" if none).
+  std::string Problems() const;
+
+ private:
+  std::map<std::string, std::string> values_;
+  mutable std::set<std::string> used_;
+  std::string bad_;                  // a malformed command line
+  mutable std::string bad_number_;   // the first value that did not parse
+};
+
+}  // namespace mbslam
+
+#endif  // MBSLAM_COMMON_UTIL_COMMAND_LINE_H_

@@ -1,0 +1,57 @@
+#include "common/util/command_line.h"
+
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace mbslam {
+namespace {
+
+CommandLineArgs Parse(const std::vector<const char*>& words, int first = 1) {
+  return CommandLineArgs(static_cast<int>(words.size()), words.data(), first);
+}
+
+TEST(CommandLineArgsTest, ValuesFlagsAndNegativeNumbers) {
+  const CommandLineArgs args =
+      Parse({"tool", "--in", "a.txt", "--verbose", "--scale", "-2.5", "--seed", "7", "--json"});
+  EXPECT_EQ(args.Get("in"), "a.txt");
+  EXPECT_TRUE(args.Has("verbose"));
+  EXPECT_EQ(args.Get("verbose", "x"), "");  // a bare flag has no value
+  EXPECT_EQ(args.Get("missing", "x"), "x");
+  EXPECT_DOUBLE_EQ(args.GetDouble("scale", 1.0), -2.5);
+  EXPECT_EQ(args.GetInt("seed", 1), 7);
+  EXPECT_TRUE(args.Has("json"));
+  EXPECT_EQ(args.GetDouble("missing", 0.25), 0.25);
+  EXPECT_EQ(args.GetInt("missing", -3), -3);
+  EXPECT_EQ(args.Problems(), "");
+}
+
+TEST(CommandLineArgsTest, ASubcommandIsSkipped) {
+  const CommandLineArgs args = Parse({"mbslam-eval", "ate", "--est", "e.tum"}, 2);
+  EXPECT_EQ(args.Get("est"), "e.tum");
+  EXPECT_EQ(args.Problems(), "");
+}
+
+TEST(CommandLineArgsTest, UnknownOptionsAreProblems) {
+  const CommandLineArgs args = Parse({"tool", "--in", "a", "--typo", "3"});
+  EXPECT_EQ(args.Get("in"), "a");
+  EXPECT_EQ(args.Problems(), "unknown option --typo");
+}
+
+TEST(CommandLineArgsTest, StrayArgumentsAreProblems) {
+  EXPECT_EQ(Parse({"tool", "a.txt"}).Problems(), "unexpected argument 'a.txt'");
+  EXPECT_EQ(Parse({"tool", "--"}).Problems(), "unexpected argument '--'");
+}
+
+TEST(CommandLineArgsTest, MalformedNumbersAreProblemsAndGiveTheFallback) {
+  const CommandLineArgs args = Parse({"tool", "--a", "1.5x", "--b", "12", "--c", "1e999", "--d", "3.0", "--e"});
+  EXPECT_EQ(args.GetDouble("a", 9.0), 9.0);
+  EXPECT_EQ(args.GetInt("b", 0), 12);
+  EXPECT_EQ(args.GetDouble("c", 9.0), 9.0);  // out of range
+  EXPECT_EQ(args.GetInt("d", 4), 4);         // not a whole number
+  EXPECT_EQ(args.GetDouble("e", 2.0), 2.0);  // a bare flag is no number
+  EXPECT_EQ(args.Problems(), "--a expects a number, got '1.5x'");  // the first one
+}
+
+}  // namespace
+}  // namespace mbslam
