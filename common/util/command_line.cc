@@ -1,6 +1,7 @@
 #include "common/util/command_line.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 
 namespace mbslam {
@@ -34,28 +35,24 @@ std::string CommandLineArgs::Get(const std::string& key, const std::string& fall
 
 double CommandLineArgs::GetDouble(const std::string& key, double fallback) const {
   if (!Has(key)) return fallback;
-  const std::string& v = values_.at(key);
-  char* end = nullptr;
-  errno = 0;
-  const double d = v.empty() ? 0.0 : std::strtod(v.c_str(), &end);
-  if (v.empty() || end != v.c_str() + v.size() || errno == ERANGE) {
-    if (bad_number_.empty()) bad_number_ = "--" + key + " expects a number, got '" + v + "'";
+  double value = fallback;
+  const Status st = ParseDouble(values_.at(key), "--" + key, &value);
+  if (!st.ok()) {
+    if (bad_number_.empty()) bad_number_ = st.message();
     return fallback;
   }
-  return d;
+  return value;
 }
 
 int64_t CommandLineArgs::GetInt(const std::string& key, int64_t fallback) const {
   if (!Has(key)) return fallback;
-  const std::string& v = values_.at(key);
-  char* end = nullptr;
-  errno = 0;
-  const long long n = v.empty() ? 0 : std::strtoll(v.c_str(), &end, 10);
-  if (v.empty() || end != v.c_str() + v.size() || errno == ERANGE) {
-    if (bad_number_.empty()) bad_number_ = "--" + key + " expects a whole number, got '" + v + "'";
+  int64_t value = fallback;
+  const Status st = ParseInt64(values_.at(key), "--" + key, &value);
+  if (!st.ok()) {
+    if (bad_number_.empty()) bad_number_ = st.message();
     return fallback;
   }
-  return static_cast<int64_t>(n);
+  return value;
 }
 
 std::string CommandLineArgs::Problems() const {
@@ -65,6 +62,28 @@ std::string CommandLineArgs::Problems() const {
     if (!used_.count(key)) return "unknown option --" + key;
   }
   return "";
+}
+
+Status ParseDouble(const std::string& text, const std::string& what, double* value) {
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end == nullptr || *end != '\0' || errno != 0 || !std::isfinite(v)) {
+    return Status::Error(what + ": '" + text + "' is not a number");
+  }
+  *value = v;
+  return Status::Ok();
+}
+
+Status ParseInt64(const std::string& text, const std::string& what, int64_t* value) {
+  errno = 0;
+  char* end = nullptr;
+  const long long v = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || end == nullptr || *end != '\0' || errno != 0) {
+    return Status::Error(what + ": '" + text + "' is not an integer");
+  }
+  *value = static_cast<int64_t>(v);
+  return Status::Ok();
 }
 
 }  // namespace mbslam

@@ -6,6 +6,8 @@
 #include <set>
 #include <string>
 
+#include "common/util/status.h"
+
 namespace mbslam {
 
 // The command line of the project's tools: `--key value` pairs and bare `--flag`s (a
@@ -13,6 +15,11 @@ namespace mbslam {
 // '-', e.g. a negative number). Every key read is remembered: Problems() then names the
 // first argument that is not an option, the first number that does not parse, or the
 // first option no one asked for.
+// Parses a whole, finite number; fails with a message naming `what` on anything else
+// (trailing text, empty, out of range, inf / nan).
+Status ParseDouble(const std::string& text, const std::string& what, double* value);
+Status ParseInt64(const std::string& text, const std::string& what, int64_t* value);
+
 class CommandLineArgs {
  public:
   // Arguments argv[first] ... argv[argc - 1] (a subcommand before them is the caller's).
@@ -21,8 +28,8 @@ class CommandLineArgs {
   bool Has(const std::string& key) const;
   // The value ("" for a bare flag), or `fallback` when the option is absent.
   std::string Get(const std::string& key, const std::string& fallback = "") const;
-  // The value as a number, or `fallback` when absent; a value that is not all a number
-  // (trailing text, empty, out of range) also gives `fallback` and is a problem.
+  // The value as a number, or `fallback` when absent; a value ParseDouble / ParseInt64
+  // refuses also gives `fallback` and is a problem.
   double GetDouble(const std::string& key, double fallback) const;
   int64_t GetInt(const std::string& key, int64_t fallback) const;
   // The first problem with the command line ("" if none).

@@ -44,13 +44,15 @@ TEST(CommandLineArgsTest, StrayArgumentsAreProblems) {
 }
 
 TEST(CommandLineArgsTest, MalformedNumbersAreProblemsAndGiveTheFallback) {
-  const CommandLineArgs args = Parse({"tool", "--a", "1.5x", "--b", "12", "--c", "1e999", "--d", "3.0", "--e"});
+  const CommandLineArgs args =
+      Parse({"tool", "--a", "1.5x", "--b", "12", "--c", "1e999", "--d", "3.0", "--e", "--f", "nan"});
   EXPECT_EQ(args.GetDouble("a", 9.0), 9.0);
   EXPECT_EQ(args.GetInt("b", 0), 12);
   EXPECT_EQ(args.GetDouble("c", 9.0), 9.0);  // out of range
   EXPECT_EQ(args.GetInt("d", 4), 4);         // not a whole number
   EXPECT_EQ(args.GetDouble("e", 2.0), 2.0);  // a bare flag is no number
-  EXPECT_EQ(args.Problems(), "--a expects a number, got '1.5x'");  // the first one
+  EXPECT_EQ(args.GetDouble("f", 2.0), 2.0);  // not finite
+  EXPECT_EQ(args.Problems(), "--a: '1.5x' is not a number");  // the first one
 }
 
 }  // namespace

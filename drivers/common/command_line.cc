@@ -1,9 +1,5 @@
 #include "drivers/common/command_line.h"
 
-#include <cerrno>
-#include <cmath>
-#include <cstdlib>
-
 namespace mbslam {
 
 Status CommandLine::Parse(int argc, const char* const* argv, const std::set<std::string>& flags,
@@ -83,28 +79,6 @@ Status ParseOptionAssignment(const std::string& assignment, YAML::Node* root) {
     node = parent;
   }
   *root = node;
-  return Status::Ok();
-}
-
-Status ParseDouble(const std::string& text, const std::string& what, double* value) {
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end == nullptr || *end != '\0' || errno != 0 || !std::isfinite(v)) {
-    return Status::Error(what + ": '" + text + "' is not a number");
-  }
-  *value = v;
-  return Status::Ok();
-}
-
-Status ParseInt64(const std::string& text, const std::string& what, int64_t* value) {
-  errno = 0;
-  char* end = nullptr;
-  const long long v = std::strtoll(text.c_str(), &end, 10);
-  if (text.empty() || end == nullptr || *end != '\0' || errno != 0) {
-    return Status::Error(what + ": '" + text + "' is not an integer");
-  }
-  *value = static_cast<int64_t>(v);
   return Status::Ok();
 }
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/config/options_yaml.h"
+#include "common/util/command_line.h"  // ParseDouble, ParseInt64
 #include "common/util/status.h"
 
 namespace mbslam {
@@ -46,10 +47,6 @@ Status ApplyOptionAssignment(const std::string& assignment, T* options) {
   MBSLAM_RETURN_IF_ERROR(ParseOptionAssignment(assignment, &root));
   return LoadOptionsFromYaml(root, "", options).WithContext("--set " + assignment);
 }
-
-// Parses a number; fails with a message naming `what` on anything else.
-Status ParseDouble(const std::string& text, const std::string& what, double* value);
-Status ParseInt64(const std::string& text, const std::string& what, int64_t* value);
 
 }  // namespace mbslam
 
