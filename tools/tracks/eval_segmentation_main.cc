@@ -10,6 +10,9 @@
 // mover's appearance are scored. Prints a summary and, last, one JSON line:
 //   moving_recall, moving_precision, detection_delay_frames (per object), misclassification
 //   (track level, Hungarian), frames_scored.
+// Env EVAL_DUMP_TP / EVAL_DUMP_FP / EVAL_DUMP_FN / EVAL_DUMP_TN=1 print each scored
+// feature of that outcome first ("TP frame F id T uv U V body B mask M p P epi E fvb F
+// age A"; FP lines add the distance to the nearest moving pixel).
 
 #include <cmath>
 #include <cstdlib>
@@ -142,6 +145,11 @@ int Run(int argc, char** argv) {
         std::printf("FP frame %lld id %lld uv %.0f %.0f body %d mask %d p %.3f epi %.2f fvb %.3f age %d dist %.1f\n",
                     static_cast<long long>(t.frame_seq), static_cast<long long>(f.id), f.u, f.v, f.body_id,
                     body, f.p_static, f.epipolar_px, f.fvb, f.age, dist.at<float>(v, u));
+      }
+      if (std::getenv("EVAL_DUMP_TN") && !truly_moving && !labelled_moving) {
+        std::printf("TN frame %lld id %lld uv %.0f %.0f body %d mask %d p %.3f epi %.2f fvb %.3f age %d\n",
+                    static_cast<long long>(t.frame_seq), static_cast<long long>(f.id), f.u, f.v, f.body_id,
+                    body, f.p_static, f.epipolar_px, f.fvb, f.age);
       }
       fn += truly_moving && !labelled_moving;
       tn += !truly_moving && !labelled_moving;
