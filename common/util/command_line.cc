@@ -55,9 +55,10 @@ int64_t CommandLineArgs::GetInt(const std::string& key, int64_t fallback) const 
   return value;
 }
 
+std::string CommandLineArgs::ParseProblems() const { return !bad_.empty() ? bad_ : bad_number_; }
+
 std::string CommandLineArgs::Problems() const {
-  if (!bad_.empty()) return bad_;
-  if (!bad_number_.empty()) return bad_number_;
+  if (const std::string parse = ParseProblems(); !parse.empty()) return parse;
   for (const auto& [key, value] : values_) {
     if (!used_.count(key)) return "unknown option --" + key;
   }

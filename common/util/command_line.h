@@ -10,16 +10,16 @@
 
 namespace mbslam {
 
-// The command line of the project's tools: `--key value` pairs and bare `--flag`s (a
-// flag is followed by another `--key` or by nothing; a value may start with a single
-// '-', e.g. a negative number). Every key read is remembered: Problems() then names the
-// first argument that is not an option, the first number that does not parse, or the
-// first option no one asked for.
 // Parses a whole, finite number; fails with a message naming `what` on anything else
 // (trailing text, empty, out of range, inf / nan).
 Status ParseDouble(const std::string& text, const std::string& what, double* value);
 Status ParseInt64(const std::string& text, const std::string& what, int64_t* value);
 
+// The command line of the project's tools: `--key value` pairs and bare `--flag`s (a
+// flag is followed by another `--key` or by nothing; a value may start with a single
+// '-', e.g. a negative number). Every key read is remembered: Problems() then names the
+// first argument that is not an option, the first number that does not parse, or the
+// first option no one asked for.
 class CommandLineArgs {
  public:
   // Arguments argv[first] ... argv[argc - 1] (a subcommand before them is the caller's).
@@ -34,6 +34,10 @@ class CommandLineArgs {
   int64_t GetInt(const std::string& key, int64_t fallback) const;
   // The first problem with the command line ("" if none).
   std::string Problems() const;
+  // The same without the unknown-option check: a malformed command line or a number read
+  // so far that did not parse. A tool checks it once its numbers are read, before any
+  // work, and Problems() at the end.
+  std::string ParseProblems() const;
 
  private:
   std::map<std::string, std::string> values_;

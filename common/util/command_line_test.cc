@@ -11,6 +11,25 @@ CommandLineArgs Parse(const std::vector<const char*>& words, int first = 1) {
   return CommandLineArgs(static_cast<int>(words.size()), words.data(), first);
 }
 
+TEST(ParseNumberTest, WholeFiniteNumbersOnly) {
+  double d = 0;
+  int64_t i = 0;
+  EXPECT_TRUE(ParseDouble("2.5", "x", &d).ok());
+  EXPECT_EQ(d, 2.5);
+  EXPECT_TRUE(ParseDouble("-1e-3", "x", &d).ok());
+  EXPECT_EQ(d, -1e-3);
+  EXPECT_FALSE(ParseDouble("2.5x", "x", &d).ok());
+  EXPECT_FALSE(ParseDouble("", "x", &d).ok());
+  EXPECT_FALSE(ParseDouble("nan", "x", &d).ok());
+  EXPECT_FALSE(ParseDouble("inf", "x", &d).ok());
+  EXPECT_FALSE(ParseDouble("1e999", "x", &d).ok());
+  EXPECT_EQ(ParseDouble("2.5x", "--scale", &d).message(), "--scale: '2.5x' is not a number");
+  EXPECT_TRUE(ParseInt64("-42", "n", &i).ok());
+  EXPECT_EQ(i, -42);
+  EXPECT_FALSE(ParseInt64("4.2", "n", &i).ok());
+  EXPECT_FALSE(ParseInt64("99999999999999999999", "n", &i).ok());
+}
+
 TEST(CommandLineArgsTest, ValuesFlagsAndNegativeNumbers) {
   const CommandLineArgs args =
       Parse({"tool", "--in", "a.txt", "--verbose", "--scale", "-2.5", "--seed", "7", "--json"});
@@ -53,6 +72,16 @@ TEST(CommandLineArgsTest, MalformedNumbersAreProblemsAndGiveTheFallback) {
   EXPECT_EQ(args.GetDouble("e", 2.0), 2.0);  // a bare flag is no number
   EXPECT_EQ(args.GetDouble("f", 2.0), 2.0);  // not finite
   EXPECT_EQ(args.Problems(), "--a: '1.5x' is not a number");  // the first one
+  EXPECT_EQ(args.ParseProblems(), args.Problems());
+}
+
+TEST(CommandLineArgsTest, ParseProblemsLeaveUnknownOptionsForLater) {
+  const CommandLineArgs args = Parse({"tool", "--n", "3", "--later", "x"});
+  EXPECT_EQ(args.GetInt("n", 0), 3);
+  EXPECT_EQ(args.ParseProblems(), "");  // --later may still be read
+  EXPECT_EQ(args.Get("later"), "x");
+  EXPECT_EQ(args.Problems(), "");
+  EXPECT_EQ(Parse({"tool", "stray"}).ParseProblems(), "unexpected argument 'stray'");
 }
 
 }  // namespace

@@ -60,17 +60,5 @@ TEST(CommandLine, AssignmentSetsNestedOptionsAndIsChecked) {
   EXPECT_FALSE(ApplyOptionAssignment("a..b=1", &options).ok());
 }
 
-TEST(CommandLine, ParsesNumbers) {
-  double d = 0;
-  int64_t i = 0;
-  EXPECT_TRUE(ParseDouble("2.5", "x", &d).ok());
-  EXPECT_EQ(d, 2.5);
-  EXPECT_FALSE(ParseDouble("2.5x", "x", &d).ok());
-  EXPECT_FALSE(ParseDouble("nan", "x", &d).ok());
-  EXPECT_TRUE(ParseInt64("-42", "n", &i).ok());
-  EXPECT_EQ(i, -42);
-  EXPECT_FALSE(ParseInt64("4.2", "n", &i).ok());
-}
-
 }  // namespace
 }  // namespace mbslam

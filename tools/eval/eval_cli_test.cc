@@ -116,6 +116,14 @@ TEST_F(EvalCli, PerturbThenAteRecoversTheKnownAnswer) {
       RunEval("ate --est " + Path("est.tum") + " --gt " + Path("gt.tum") + " --bogus 1", nullptr),
       0);
   EXPECT_NE(RunEval("no-such-command", nullptr), 0);
+  // A malformed number fails before any output is written (not with its default).
+  EXPECT_EQ(RunEval("perturb --in " + Path("gt.tum") + " --out " + Path("bad.tum") + " --scale 0.3x", nullptr), 1);
+  EXPECT_FALSE(fs::exists(Path("bad.tum")));
+  EXPECT_EQ(RunEval("ate --est " + Path("est.tum") + " --gt " + Path("gt.tum") + " --max-dt-us 1.5x --plot " +
+                        Path("bad.png"),
+                    nullptr),
+            1);
+  EXPECT_FALSE(fs::exists(Path("bad.png")));
 }
 
 TEST_F(EvalCli, PerturbLabelsThenSegRecoversTheKnownAnswer) {

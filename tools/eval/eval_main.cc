@@ -16,11 +16,9 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
-#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -108,8 +106,9 @@ Status LoadGroundTruthCamera(const mbslam::CommandLineArgs& args, const mbslam::
   }
   if (args.Has("gt-tartanair")) {
     *description = args.Get("gt-tartanair");
-    return eval::ReadTartanAirPoses(args.Get("gt-tartanair"),
-                                    args.GetInt("frame-period-us", 1000000), gt);
+    const int64_t frame_period_us = args.GetInt("frame-period-us", 1000000);
+    if (const std::string problems = args.ParseProblems(); !problems.empty()) return Status::Error(problems);
+    return eval::ReadTartanAirPoses(args.Get("gt-tartanair"), frame_period_us, gt);
   }
   return Status::Error(
       "ate: give --gt FILE.tum, --gt-log LOG, --gt-sequence DIR or --gt-tartanair pose_left.txt");
@@ -117,6 +116,13 @@ Status LoadGroundTruthCamera(const mbslam::CommandLineArgs& args, const mbslam::
 
 int RunAte(const mbslam::CommandLineArgs& args) {
   const mbslam::ChannelOptions channels;
+  eval::AteOptions options;
+  options.alignment = args.Get("align", "sim3");
+  options.max_time_diff_us = args.GetInt("max-dt-us", options.max_time_diff_us);
+  eval::RpeOptions rpe_options;
+  rpe_options.delta_frames = static_cast<int>(args.GetInt("rpe-delta", 1));
+  rpe_options.delta_us = args.GetInt("rpe-delta-us", 0);
+  if (const std::string problems = args.ParseProblems(); !problems.empty()) return Fail(problems);
   eval::Trajectory est, gt;
   std::string gt_description, est_description;
   int est_messages = -1, est_metric = 0;
@@ -142,17 +148,11 @@ int RunAte(const mbslam::CommandLineArgs& args) {
     return Fail(st.message());
   }
 
-  eval::AteOptions options;
-  options.alignment = args.Get("align", "sim3");
-  options.max_time_diff_us = args.GetInt("max-dt-us", options.max_time_diff_us);
   eval::AteResult ate;
   st = eval::ComputeAte(est, gt, options, &ate);
   if (!st.ok()) {
     return Fail(st.message());
   }
-  eval::RpeOptions rpe_options;
-  rpe_options.delta_frames = static_cast<int>(args.GetInt("rpe-delta", 1));
-  rpe_options.delta_us = args.GetInt("rpe-delta-us", 0);
   rpe_options.est_scale = ate.gt_from_est.scale;
   eval::RpeResult rpe;
   const Status rpe_status = eval::ComputeRpe(est, gt, ate.pairs, rpe_options, &rpe);
@@ -462,6 +462,11 @@ int RunCamVid(const mbslam::CommandLineArgs& args) {
 // ---------------------------------------------------------------- objects
 
 int RunObjects(const mbslam::CommandLineArgs& args) {
+  eval::ObjectMetricsOptions options;
+  options.horizon_us = args.GetInt("horizon-us", options.horizon_us);
+  options.max_match_distance = args.GetDouble("max-match-m", options.max_match_distance);
+  options.settle_us = args.GetInt("settle-us", options.settle_us);
+  if (const std::string problems = args.ParseProblems(); !problems.empty()) return Fail(problems);
   const mbslam::ChannelOptions channels;
   if (!args.Has("est-log") || !args.Has("gt-log")) {
     return Fail("objects: give --est-log LOG --gt-log LOG");
@@ -494,10 +499,6 @@ int RunObjects(const mbslam::CommandLineArgs& args) {
   if (!st.ok()) {
     return Fail("objects: cannot align the estimate's world frame: " + st.message());
   }
-  eval::ObjectMetricsOptions options;
-  options.horizon_us = args.GetInt("horizon-us", options.horizon_us);
-  options.max_match_distance = args.GetDouble("max-match-m", options.max_match_distance);
-  options.settle_us = args.GetInt("settle-us", options.settle_us);
   eval::ObjectsEvaluation result;
   st = eval::EvaluateObjects(objects, gt.bodies, gt.camera, ate.gt_from_est, options, &result);
   if (!st.ok()) {
@@ -608,6 +609,9 @@ int RunObjects(const mbslam::CommandLineArgs& args) {
 // ---------------------------------------------------------------- reconstructions
 
 int RunReconstructions(const mbslam::CommandLineArgs& args) {
+  const int min_samples = static_cast<int>(args.GetInt("min-samples", 10));
+  const int64_t max_dt = args.GetInt("max-dt-us", 20000);
+  if (const std::string problems = args.ParseProblems(); !problems.empty()) return Fail(problems);
   const mbslam::ChannelOptions channels;
   if (!args.Has("dir") || !args.Has("gt-log")) {
     return Fail("reconstructions: give --dir RESULT/reconstructions --gt-log LOG");
@@ -620,8 +624,6 @@ int RunReconstructions(const mbslam::CommandLineArgs& args) {
     st = eval::ReadReconstructions(args.Get("dir"), &recs);
     if (!st.ok()) return Fail(st.message());
   }
-  const int min_samples = static_cast<int>(args.GetInt("min-samples", 10));
-  const int64_t max_dt = args.GetInt("max-dt-us", 20000);
   Json list = Json::Array();
   const eval::ReconstructionResult* longest = nullptr;
   std::vector<eval::ReconstructionResult> results;
@@ -678,6 +680,9 @@ int RunReconstructions(const mbslam::CommandLineArgs& args) {
 // ---------------------------------------------------------------- points
 
 int RunPoints(const mbslam::CommandLineArgs& args) {
+  const double threshold = args.GetDouble("threshold", 0.05);
+  const double max_distance = args.GetDouble("max-distance", 1.0);
+  if (const std::string problems = args.ParseProblems(); !problems.empty()) return Fail(problems);
   if (!args.Has("est") || !args.Has("gt")) {
     return Fail("points: give --est XYZ --gt XYZ (same frame and units)");
   }
@@ -689,8 +694,6 @@ int RunPoints(const mbslam::CommandLineArgs& args) {
   if (!st.ok()) {
     return Fail(st.message());
   }
-  const double threshold = args.GetDouble("threshold", 0.05);
-  const double max_distance = args.GetDouble("max-distance", 1.0);
   const eval::ReconstructionError e = eval::CompareToSurface(est, gt, threshold, max_distance);
   std::printf(
       "reconstruction: %zu points against %zu true samples: accuracy median %.4f m, rmse %.4f m, "
@@ -734,6 +737,7 @@ int RunPerturb(const mbslam::CommandLineArgs& args) {
   p.noise_sigma_m = args.GetDouble("noise", 0.0);
   p.seed = static_cast<uint64_t>(args.GetInt("seed", 1));
   p.exact = !args.Has("no-exact");
+  if (const std::string problems = args.ParseProblems(); !problems.empty()) return Fail(problems);
   double expected = 0.0;
   st = eval::PerturbTrajectory(gt, p, &est, &expected);
   if (st.ok()) {
@@ -766,6 +770,7 @@ int RunPerturbLabels(const mbslam::CommandLineArgs& args) {
   p.merge_smallest = args.Has("merge");
   p.permute = !args.Has("no-permute");
   p.seed = static_cast<uint64_t>(args.GetInt("seed", 1));
+  if (const std::string problems = args.ParseProblems(); !problems.empty()) return Fail(problems);
   int expected = 0;
   st = eval::PerturbLabels(truth, p, &pred, &expected);
   if (st.ok()) {
@@ -885,7 +890,7 @@ void Usage() {
   reconstructions  moving objects' own reconstructions (result/reconstructions/): camera-relative
            trajectory and shape (point-to-box distance) after a similarity, per body
            --dir DIR --gt-log LOG [--min-samples 10] [--max-dt-us N]
-           (env EVAL_DUMP_SHAPE=1: each scored point in its body's frame and its distance, to stderr)
+           (env EVAL_DUMP_SHAPE set, to any value: each scored point in its body's frame and its distance, to stderr)
   points   reconstruction accuracy / completeness against ground-truth surface points
            --est XYZ --gt XYZ (e.g. <sequence>/points/<id>.txt) [--threshold 0.05] [--max-distance 1.0]
   perturb  write a trajectory with a known similarity and noise (expected ATE printed)

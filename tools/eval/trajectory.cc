@@ -4,12 +4,12 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 
 #include "common/util/atomic_file.h"
+#include "common/util/command_line.h"
 
 namespace mbslam {
 namespace eval {
@@ -37,11 +37,8 @@ std::vector<std::string> Tokens(const std::string& line) {
   return out;
 }
 
-bool ParseDouble(const std::string& token, double* value) {
-  char* end = nullptr;
-  *value = std::strtod(token.c_str(), &end);
-  return end && *end == '\0' && end != token.c_str();
-}
+// A whole, finite number (the tools' one parser).
+bool ParseDouble(const std::string& token, double* value) { return mbslam::ParseDouble(token, "", value).ok(); }
 
 Rigid3d PoseFromXyzQxyzw(const double v[7]) {
   Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);  // w, x, y, z

@@ -5,12 +5,10 @@
 //       --sequence out/static [--resolution 0.1] [--max-range 20] [--align sim3|se3|none]
 //       [--pixel-step 1] [--frame-step 1] [--all-frames] [--max-dt-us 20000] [--json FILE]
 
-#include <cstdlib>
 #include <exception>
 #include <iomanip>
 #include <iostream>
-#include <map>
-#include <set>
+#include <limits>
 #include <string>
 
 #include "common/util/atomic_file.h"
@@ -55,6 +53,12 @@ int Run(int argc, char** argv) {
   const int64_t pixel_step = args.GetInt("pixel-step", options.pixel_step);
   const int64_t frame_step = args.GetInt("frame-step", options.frame_step);
   const int64_t max_dt = args.GetInt("max-dt-us", options.max_time_diff_us);
+  for (const auto& [name, step] : {std::pair{"--pixel-step", pixel_step}, std::pair{"--frame-step", frame_step}}) {
+    if (step < 1 || step > std::numeric_limits<int>::max()) {
+      return Fail(std::string(name) + " expects a whole number from 1 to " +
+                  std::to_string(std::numeric_limits<int>::max()));
+    }
+  }
   options.pixel_step = static_cast<int>(pixel_step);
   options.frame_step = static_cast<int>(frame_step);
   options.max_time_diff_us = max_dt;

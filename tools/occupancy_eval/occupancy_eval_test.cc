@@ -396,6 +396,12 @@ TEST_F(OccupancyEval, CommandLinePrintsTheJsonKeys) {
             0);  // no traj
   EXPECT_NE(
       RunCli("--bt " + Path("truth.bt") + " --sequence " + Path("seq") + " --bogus 1", nullptr), 0);
+  // Malformed or out-of-range numbers are refused before any work.
+  const std::string base = "--bt " + Path("truth.bt") + " --est-traj " + Path("truth.tum") + " --sequence " + Path("seq");
+  EXPECT_EQ(RunCli(base + " --pixel-step 2x", nullptr), 1);
+  EXPECT_EQ(RunCli(base + " --frame-step 1.5", nullptr), 1);
+  EXPECT_EQ(RunCli(base + " --pixel-step 4294967297", nullptr), 1);  // beyond an int
+  EXPECT_EQ(RunCli(base + " --max-range inf", nullptr), 1);
   EXPECT_EQ(
       RunCli("--bt " + Path("truth.bt") + " --sequence " + Path("seq") + " --align none", &json),
       0);  // the map in its own frame: nothing lines up

@@ -205,6 +205,9 @@ TEST_F(PlannerExampleCli, NoDataOrBadInput) {
   EXPECT_EQ(RunPlanner("--lcm-url " + Url() + " --waypoints '0 0 0'", &out), 2);
   EXPECT_EQ(RunPlanner("--lcm-url " + Url(), &out), 2);
   EXPECT_EQ(RunPlanner("--lcm-url " + Url() + " --waypoints '0 0 2 1' --bogus", &out), 2);
+  // A malformed number is bad input, not its default.
+  EXPECT_EQ(RunPlanner("--lcm-url " + Url() + " --waypoints '0 0 2 1' --robot-radius 0.3m", &out), 2);
+  EXPECT_EQ(RunPlanner("--lcm-url " + Url() + " --waypoints '0 0 2 1' --horizon nan", &out), 2);
   EXPECT_EQ(RunPlanner("--lcm-url " + Url() + " --waypoints '0 0 2 1' --require-metric", &out), 0);
   // An up-to-scale world: answered in map units, or refused on request.
   const std::string uts = (dir_ / "up_to_scale.lcmlog").string();

@@ -12,12 +12,9 @@
 
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <iostream>
-#include <map>
 #include <memory>
-#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -25,9 +22,9 @@
 #include "common/config/options_yaml.h"
 #include "common/lcm/channels.h"
 #include "common/lcm/lcm_bus.h"
-#include "common/util/command_line.h"
 #include "common/lcm/wire_check.h"
 #include "common/util/atomic_file.h"
+#include "common/util/command_line.h"
 #include "common/util/shutdown.h"
 #include "mbslam/camera_pose_t.hpp"
 #include "mbslam/objects_t.hpp"

@@ -10,7 +10,7 @@
 // mover's appearance are scored. Prints a summary and, last, one JSON line:
 //   moving_recall, moving_precision, detection_delay_frames (per object), misclassification
 //   (track level, Hungarian), frames_scored.
-// Env EVAL_DUMP_TP / EVAL_DUMP_FP / EVAL_DUMP_FN / EVAL_DUMP_TN=1 print each scored
+// Env EVAL_DUMP_TP / EVAL_DUMP_FP / EVAL_DUMP_FN / EVAL_DUMP_TN set (to any value) print each scored
 // feature of that outcome first ("TP frame F id T uv U V body B mask M p P epi E fvb F
 // age A"; FP lines add the distance to the nearest moving pixel).
 

@@ -401,7 +401,8 @@ TEST(ObjectReconstructionTest, MaturePointsNeedThreeKeyframesOnceThereAreThree) 
 }
 
 // The published points' ids: mature points of the body, without those off it (each
-// filter on what the previous one kept; the same points the filters give one by one).
+// filter on what the previous one kept; the same points, in the same order, as the
+// filters one by one).
 TEST(ObjectReconstructionTest, BodyPointIdsAreTheMaturePointsOnTheBody) {
   Map map;
   std::vector<int64_t> kf;
@@ -413,18 +414,28 @@ TEST(ObjectReconstructionTest, BodyPointIdsAreTheMaturePointsOnTheBody) {
     for (int v = 0; v < views; ++v) map.AddObservation(id, kf[static_cast<size_t>(v)], Eigen::Vector2d::Zero());
     return id;
   };
-  // A 0.4 x 0.5 x 1.75 box's surface, sampled on a grid, seen from all three keyframes.
+  // A 0.4 x 0.5 x 1.75 box's sides, sampled every 0.1 m around and 0.25 m up, seen from
+  // all three keyframes: one cluster (neighbours 0.1 m apart, links up to 0.3 m).
   std::vector<int64_t> body;
-  for (int i = 0; i < 6; ++i) {
-    for (int j = 0; j < 6; ++j) {
-      const double y = -0.25 + 0.1 * i, z = -0.875 + 0.35 * j;
+  for (int k = 0; k < 8; ++k) {
+    const double z = -0.875 + 0.25 * k;
+    for (int i = 0; i < 6; ++i) {
+      const double y = -0.25 + 0.1 * i;
       body.push_back(add_point(Eigen::Vector3d(0.2, y, z), 3));
       body.push_back(add_point(Eigen::Vector3d(-0.2, y, z), 3));
     }
+    for (int i = 0; i < 3; ++i) {
+      const double x = -0.1 + 0.1 * i;
+      body.push_back(add_point(Eigen::Vector3d(x, 0.25, z), 3));
+      body.push_back(add_point(Eigen::Vector3d(x, -0.25, z), 3));
+    }
   }
   const int64_t young = add_point(Eigen::Vector3d(0.0, 0.0, 0.0), 2);  // two views: not mature
-  const int64_t far = add_point(Eigen::Vector3d(0.2, 0.0, 8.0), 3);    // far off the body
-  const int64_t beside = add_point(Eigen::Vector3d(1.2, 0.05, 0.0), 3);  // off its thin side
+  const int64_t far = add_point(Eigen::Vector3d(0.2, 0.0, 8.0), 3);    // the radius leaves it out
+  std::vector<int64_t> clump;  // a small group 1.3 m off: the cluster step leaves it out
+  for (int i = 0; i < 4; ++i) clump.push_back(add_point(Eigen::Vector3d(1.5 + 0.05 * i, 0.0, 0.0), 3));
+  std::vector<int64_t> chain;  // a chain off the thin side, linked to the body: the axes cut its end
+  for (int i = 1; i <= 6; ++i) chain.push_back(add_point(Eigen::Vector3d(0.2 + 0.1 * i, 0.0, 0.0), 3));
   ObjectReconstructionOptions options;
   options.min_point_keyframes = 3;
   const std::vector<int64_t> ids = BodyPointIds(map, options);
@@ -433,17 +444,26 @@ TEST(ObjectReconstructionTest, BodyPointIdsAreTheMaturePointsOnTheBody) {
   for (int64_t id : body) EXPECT_TRUE(kept.count(id)) << id;
   EXPECT_FALSE(kept.count(young));
   EXPECT_FALSE(kept.count(far));
-  EXPECT_FALSE(kept.count(beside));
-  // The same as the filters one by one on the mature points.
-  const std::vector<Eigen::Vector3d> chained = AxisCompactPoints(
-      LargestCluster(CompactPoints(MaturePoints(map, 3), options.max_point_spread), options.cluster_link_factor),
-      options.max_axis_mads, options.min_axis_mad_share);
-  EXPECT_EQ(chained.size(), ids.size());
+  for (int64_t id : clump) EXPECT_FALSE(kept.count(id)) << id;
+  EXPECT_TRUE(kept.count(chain.front()));
+  EXPECT_FALSE(kept.count(chain.back()));
+  // Each step had something to do.
+  const std::vector<Eigen::Vector3d> mature = MaturePoints(map, 3);
+  const std::vector<Eigen::Vector3d> compact = CompactPoints(mature, options.max_point_spread);
+  const std::vector<Eigen::Vector3d> cluster = LargestCluster(compact, options.cluster_link_factor);
+  const std::vector<Eigen::Vector3d> chained =
+      AxisCompactPoints(cluster, options.max_axis_mads, options.min_axis_mad_share);
+  EXPECT_LT(compact.size(), mature.size());
+  EXPECT_LT(cluster.size(), compact.size());
+  EXPECT_LT(chained.size(), cluster.size());
+  // The same points in the same order.
+  ASSERT_EQ(chained.size(), ids.size());
+  for (size_t k = 0; k < ids.size(); ++k) EXPECT_EQ(map.point(ids[k])->position, chained[k]) << k;
   // Filters off: every mature point.
   options.max_point_spread = 0.0;
   options.cluster_link_factor = 0.0;
   options.max_axis_mads = 0.0;
-  EXPECT_EQ(BodyPointIds(map, options).size(), body.size() + 2);
+  EXPECT_EQ(BodyPointIds(map, options).size(), mature.size());
 }
 
 }  // namespace
