@@ -15,9 +15,9 @@ CommandLineArgs::CommandLineArgs(int argc, const char* const* argv, int first) {
     }
     a = a.substr(2);
     if (i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0) {
-      values_[a] = argv[++i];
+      values_[a].push_back(argv[++i]);
     } else {
-      values_[a] = "";
+      values_[a].push_back("");
     }
   }
 }
@@ -30,13 +30,19 @@ bool CommandLineArgs::Has(const std::string& key) const {
 std::string CommandLineArgs::Get(const std::string& key, const std::string& fallback) const {
   used_.insert(key);
   auto it = values_.find(key);
-  return it == values_.end() ? fallback : it->second;
+  return it == values_.end() ? fallback : it->second.back();
+}
+
+std::vector<std::string> CommandLineArgs::GetAll(const std::string& key) const {
+  used_.insert(key);
+  auto it = values_.find(key);
+  return it == values_.end() ? std::vector<std::string>() : it->second;
 }
 
 double CommandLineArgs::GetDouble(const std::string& key, double fallback) const {
   if (!Has(key)) return fallback;
   double value = fallback;
-  const Status st = ParseDouble(values_.at(key), "--" + key, &value);
+  const Status st = ParseDouble(values_.at(key).back(), "--" + key, &value);
   if (!st.ok()) {
     if (bad_number_.empty()) bad_number_ = st.message();
     return fallback;
@@ -47,7 +53,7 @@ double CommandLineArgs::GetDouble(const std::string& key, double fallback) const
 int64_t CommandLineArgs::GetInt(const std::string& key, int64_t fallback) const {
   if (!Has(key)) return fallback;
   int64_t value = fallback;
-  const Status st = ParseInt64(values_.at(key), "--" + key, &value);
+  const Status st = ParseInt64(values_.at(key).back(), "--" + key, &value);
   if (!st.ok()) {
     if (bad_number_.empty()) bad_number_ = st.message();
     return fallback;

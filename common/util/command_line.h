@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "common/util/status.h"
 
@@ -26,8 +27,11 @@ class CommandLineArgs {
   CommandLineArgs(int argc, const char* const* argv, int first = 1);
 
   bool Has(const std::string& key) const;
-  // The value ("" for a bare flag), or `fallback` when the option is absent.
+  // The value ("" for a bare flag), or `fallback` when the option is absent; an option
+  // given more than once: its last value.
   std::string Get(const std::string& key, const std::string& fallback = "") const;
+  // Every value of an option given more than once, in order (none when absent).
+  std::vector<std::string> GetAll(const std::string& key) const;
   // The value as a number, or `fallback` when absent; a value ParseDouble / ParseInt64
   // refuses also gives `fallback` and is a problem.
   double GetDouble(const std::string& key, double fallback) const;
@@ -40,7 +44,7 @@ class CommandLineArgs {
   std::string ParseProblems() const;
 
  private:
-  std::map<std::string, std::string> values_;
+  std::map<std::string, std::vector<std::string>> values_;
   mutable std::set<std::string> used_;
   std::string bad_;                  // a malformed command line
   mutable std::string bad_number_;   // the first value that did not parse

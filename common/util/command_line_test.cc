@@ -1,5 +1,6 @@
 #include "common/util/command_line.h"
 
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -42,6 +43,15 @@ TEST(CommandLineArgsTest, ValuesFlagsAndNegativeNumbers) {
   EXPECT_TRUE(args.Has("json"));
   EXPECT_EQ(args.GetDouble("missing", 0.25), 0.25);
   EXPECT_EQ(args.GetInt("missing", -3), -3);
+  EXPECT_EQ(args.Problems(), "");
+}
+
+TEST(CommandLineArgsTest, RepeatedOptionsKeepEveryValue) {
+  const CommandLineArgs args = Parse({"tool", "--exclude", "a", "--exclude", "b", "--n", "1", "--n", "2"});
+  EXPECT_EQ(args.GetAll("exclude"), (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(args.Get("exclude"), "b");  // the last
+  EXPECT_EQ(args.GetInt("n", 0), 2);
+  EXPECT_TRUE(args.GetAll("missing").empty());
   EXPECT_EQ(args.Problems(), "");
 }
 

@@ -28,6 +28,7 @@
 #include "common/lcm/channels.h"
 #include "common/lcm/lcm_log.h"
 #include "common/lcm/wire_check.h"
+#include "common/util/command_line.h"
 #include "mbslam/ground_truth_t.hpp"
 #include "mbslam/tracks_t.hpp"
 #include "tools/tracks/misclassification.h"
@@ -36,18 +37,13 @@ namespace mbslam {
 namespace {
 
 int Run(int argc, char** argv) {
-  std::string run, seq, name = "sequence";
-  int settle = 10;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--run" && i + 1 < argc) run = argv[++i];
-    else if (a == "--sequence" && i + 1 < argc) seq = argv[++i];
-    else if (a == "--settle" && i + 1 < argc) settle = std::atoi(argv[++i]);
-    else if (a == "--name" && i + 1 < argc) name = argv[++i];
-    else {
-      std::fprintf(stderr, "usage: mbslam-eval-segmentation --run OUT.lcmlog --sequence SIM_DIR [--settle N]\n");
-      return 2;
-    }
+  const CommandLineArgs args(argc, argv);
+  const std::string run = args.Get("run"), seq = args.Get("sequence"), name = args.Get("name", "sequence");
+  const int settle = static_cast<int>(args.GetInt("settle", 10));
+  if (const std::string problems = args.Problems(); !problems.empty()) {
+    std::fprintf(stderr, "mbslam-eval-segmentation: %s\nusage: mbslam-eval-segmentation --run OUT.lcmlog --sequence SIM_DIR [--settle N] [--name NAME]\n",
+                 problems.c_str());
+    return 2;
   }
   if (run.empty() || seq.empty()) {
     std::fprintf(stderr, "mbslam-eval-segmentation: --run and --sequence are required\n");

@@ -14,21 +14,17 @@
 #include "common/lcm/channels.h"
 #include "common/lcm/lcm_log.h"
 #include "common/lcm/wire_check.h"
+#include "common/util/command_line.h"
 #include "mbslam/tracks_t.hpp"
 
 int main(int argc, char** argv) {
-  std::string run, seq, out = "overlay.png";
-  long long frame = 0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--run" && i + 1 < argc) run = argv[++i];
-    else if (a == "--sequence" && i + 1 < argc) seq = argv[++i];
-    else if (a == "--frame" && i + 1 < argc) frame = std::atoll(argv[++i]);
-    else if (a == "--out" && i + 1 < argc) out = argv[++i];
-    else {
-      std::fprintf(stderr, "usage: mbslam-overlay --run OUT.lcmlog --sequence SEQ_DIR --frame N --out FILE.png\n");
-      return 2;
-    }
+  const mbslam::CommandLineArgs args(argc, argv);
+  const std::string run = args.Get("run"), seq = args.Get("sequence"), out = args.Get("out", "overlay.png");
+  const long long frame = args.GetInt("frame", 0);
+  if (const std::string problems = args.Problems(); !problems.empty() || run.empty() || seq.empty()) {
+    std::fprintf(stderr, "%s%susage: mbslam-overlay --run OUT.lcmlog --sequence SEQ_DIR --frame N --out FILE.png\n",
+                 problems.c_str(), problems.empty() ? "" : "\n");
+    return 2;
   }
   std::vector<mbslam::LcmLogEvent> events;
   mbslam::ReadLcmLog(run, &events, mbslam::ChannelOptions().perception_tracks);

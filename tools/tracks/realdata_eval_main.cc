@@ -28,6 +28,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/lcm/channels.h"
+#include "common/util/command_line.h"
 #include "tools/eval/json.h"
 #include "tools/eval/lcm_readers.h"
 #include "tools/tracks/realdata_scoring.h"
@@ -112,23 +113,22 @@ int TrackedFrames(const std::string& log, const ChannelOptions& ch) {
   return static_cast<int>(poses.tracked.size());
 }
 
-int RunDavis(const std::map<std::string, std::string>& args) {
-  auto get = [&](const std::string& k) {
-    auto it = args.find(k);
-    return it == args.end() ? std::string() : it->second;
-  };
+int RunDavis(const CommandLineArgs& args) {
+  auto get = [&](const std::string& k) { return args.Get(k); };
   const std::string root = get("root"), runs = get("runs"), per_frame_dir = get("per-frame-dir");
-  if (root.empty() || runs.empty()) return Usage();
   const std::string overlay_dir = get("overlay-dir");
-  const size_t overlay_every = get("overlay-every").empty() ? 1 : std::max(1, std::stoi(get("overlay-every")));
+  const size_t overlay_every = static_cast<size_t>(std::max<int64_t>(1, args.GetInt("overlay-every", 1)));
+  const std::string dump_path = get("dump"), sequences = get("sequences");
+  if (const std::string problems = args.Problems(); !problems.empty()) return Fail(problems);
+  if (root.empty() || runs.empty()) return Usage();
   std::ofstream dump;
-  if (!get("dump").empty()) {
-    dump.open(get("dump"));
+  if (!dump_path.empty()) {
+    dump.open(dump_path);
     dump << kDumpHeader;
   }
   std::set<std::string> wanted;
   {
-    std::stringstream ss(get("sequences"));
+    std::stringstream ss(sequences);
     std::string s;
     while (std::getline(ss, s, ',')) {
       if (!s.empty()) wanted.insert(s);
@@ -270,12 +270,12 @@ int RunDavis(const std::map<std::string, std::string>& args) {
   return 0;
 }
 
-int RunCamVid(const std::map<std::string, std::string>& args) {
-  auto get = [&](const std::string& k) {
-    auto it = args.find(k);
-    return it == args.end() ? std::string() : it->second;
-  };
+int RunCamVid(const CommandLineArgs& args) {
+  auto get = [&](const std::string& k) { return args.Get(k); };
   const std::string root = get("root"), log = get("run");
+  const size_t every = static_cast<size_t>(std::max<int64_t>(1, args.GetInt("overlay-every", 1)));
+  const std::string dump_path = get("dump"), overlay_dir = get("overlay-dir");
+  if (const std::string problems = args.Problems(); !problems.empty()) return Fail(problems);
   if (root.empty() || log.empty()) return Usage();
   std::vector<eval::CamVidFrame> frames;
   Status st = eval::ReadCamVid(root, &frames);
@@ -289,14 +289,12 @@ int RunCamVid(const std::map<std::string, std::string>& args) {
   st = eval::ScoreCamVid(frames, run, &s);
   if (!st.ok()) return Fail(st.message());
   const int tracked = TrackedFrames(log, ch);
-  if (!get("dump").empty() || !get("overlay-dir").empty()) {
+  if (!dump_path.empty() || !overlay_dir.empty()) {
     std::ofstream dump;
-    if (!get("dump").empty()) {
-      dump.open(get("dump"));
+    if (!dump_path.empty()) {
+      dump.open(dump_path);
       dump << kDumpHeader;
     }
-    const std::string overlay_dir = get("overlay-dir");
-    const size_t every = get("overlay-every").empty() ? 1 : std::max(1, std::stoi(get("overlay-every")));
     if (!overlay_dir.empty()) fs::create_directories(overlay_dir);
     for (size_t i = 0; i < frames.size(); ++i) {
       const cv::Mat labels = cv::imread(frames[i].label, cv::IMREAD_GRAYSCALE);
@@ -366,12 +364,7 @@ int RunCamVid(const std::map<std::string, std::string>& args) {
 int Run(int argc, char** argv) {
   if (argc < 2) return Usage();
   const std::string cmd = argv[1];
-  std::map<std::string, std::string> args;
-  for (int i = 2; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a.rfind("--", 0) != 0 || i + 1 >= argc) return Usage();
-    args[a.substr(2)] = argv[++i];
-  }
+  const CommandLineArgs args(argc, argv, 2);
   if (cmd == "davis") return RunDavis(args);
   if (cmd == "camvid") return RunCamVid(args);
   return Usage();

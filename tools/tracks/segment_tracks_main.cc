@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "common/util/command_line.h"
 #include "services/perception/segmentation/motion_segmenter.h"
 #include "services/perception/segmentation/subspace_clustering.h"
 #include "services/perception/segmentation/tracks_file.h"
@@ -89,38 +90,38 @@ int Run(int argc, char** argv) {
   int max_tracks = 400;  // tracks clustered per initialisation (the service default is 250)
   int every = 5;  // re-initialise often: the labels reported are those of the last grouping (multibody_hold)
   double heading_keep_ratio = seg_defaults.two_view.heading_keep_ratio;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--root" && i + 1 < argc) root = argv[++i];
-    else if (a == "--mode" && i + 1 < argc) mode = argv[++i];
-    else if (a == "--exclude" && i + 1 < argc) exclude.insert(argv[++i]);
-    else if (a == "--only" && i + 1 < argc) only = argv[++i];
-    else if (a == "--focal-factor" && i + 1 < argc) focal_factor = std::atof(argv[++i]);
-    else if (a == "--ssc-alpha" && i + 1 < argc) sc_options.alpha = std::atof(argv[++i]);
-    else if (a == "--ssc-projection" && i + 1 < argc) sc_options.projection_dims_per_motion = std::atoi(argv[++i]);
-    else if (a == "--ssc-mass" && i + 1 < argc) sc_options.coefficient_masses = {std::atof(argv[++i])};
-    else if (a == "--method" && i + 1 < argc) sc_options.method = argv[++i];
-    else if (a == "--lsr-lambda" && i + 1 < argc) sc_options.lsr_lambda = std::atof(argv[++i]);
-    else if (a == "--merge-ratio" && i + 1 < argc) sc_options.merge_ratio = std::atof(argv[++i]);
-    else if (a == "--cut-weight" && i + 1 < argc) sc_options.order_cut_weight = std::atof(argv[++i]);
-    else if (a == "--multibody-evidence" && i + 1 < argc) mb_evidence = std::atof(argv[++i]);
-    else if (a == "--keep-objects" && i + 1 < argc) keep_objects = std::atoi(argv[++i]) != 0;
-    else if (a == "--hold" && i + 1 < argc) hold = std::atoi(argv[++i]) != 0;
-    else if (a == "--multibody-every" && i + 1 < argc) every = std::atoi(argv[++i]);
-    else if (a == "--multibody-max-frames" && i + 1 < argc) max_frames = std::atoi(argv[++i]);
-    else if (a == "--multibody-max-tracks" && i + 1 < argc) max_tracks = std::atoi(argv[++i]);
-    else if (a == "--order" && i + 1 < argc) sc_options.order_selection = argv[++i];
-    else if (a == "--silhouette-cut" && i + 1 < argc) sc_options.silhouette_cut_weight = std::atof(argv[++i]);
-    else if (a == "--silhouette-residual" && i + 1 < argc) sc_options.silhouette_residual_weight = std::atof(argv[++i]);
-    else if (a == "--min-silhouette" && i + 1 < argc) sc_options.min_silhouette = std::atof(argv[++i]);
-    else if (a == "--max-motions" && i + 1 < argc) sc_options.max_motions = std::atoi(argv[++i]);
-    else if (a == "--refine" && i + 1 < argc) sc_options.refine_iterations = std::atoi(argv[++i]);
-    else if (a == "--subspace-dim" && i + 1 < argc) sc_options.subspace_dimension = std::atoi(argv[++i]);
-    else if (a == "--heading-keep-ratio" && i + 1 < argc) heading_keep_ratio = std::atof(argv[++i]);
-    else {
-      std::fprintf(stderr, "usage: mbslam-segment-tracks --root DIR [--mode known_k|online|both] [--exclude NAME] [--only NAME]\n");
-      return 2;
-    }
+  const CommandLineArgs args(argc, argv);
+  root = args.Get("root");
+  mode = args.Get("mode", mode);
+  for (const std::string& name : args.GetAll("exclude")) exclude.insert(name);
+  only = args.Get("only");
+  focal_factor = args.GetDouble("focal-factor", focal_factor);
+  sc_options.alpha = args.GetDouble("ssc-alpha", sc_options.alpha);
+  sc_options.projection_dims_per_motion =
+      static_cast<int>(args.GetInt("ssc-projection", sc_options.projection_dims_per_motion));
+  if (args.Has("ssc-mass")) sc_options.coefficient_masses = {args.GetDouble("ssc-mass", 0.0)};
+  sc_options.method = args.Get("method", sc_options.method);
+  sc_options.lsr_lambda = args.GetDouble("lsr-lambda", sc_options.lsr_lambda);
+  sc_options.merge_ratio = args.GetDouble("merge-ratio", sc_options.merge_ratio);
+  sc_options.order_cut_weight = args.GetDouble("cut-weight", sc_options.order_cut_weight);
+  mb_evidence = args.GetDouble("multibody-evidence", mb_evidence);
+  keep_objects = args.GetInt("keep-objects", keep_objects ? 1 : 0) != 0;
+  hold = args.GetInt("hold", hold ? 1 : 0) != 0;
+  every = static_cast<int>(args.GetInt("multibody-every", every));
+  max_frames = static_cast<int>(args.GetInt("multibody-max-frames", max_frames));
+  max_tracks = static_cast<int>(args.GetInt("multibody-max-tracks", max_tracks));
+  sc_options.order_selection = args.Get("order", sc_options.order_selection);
+  sc_options.silhouette_cut_weight = args.GetDouble("silhouette-cut", sc_options.silhouette_cut_weight);
+  sc_options.silhouette_residual_weight = args.GetDouble("silhouette-residual", sc_options.silhouette_residual_weight);
+  sc_options.min_silhouette = args.GetDouble("min-silhouette", sc_options.min_silhouette);
+  sc_options.max_motions = static_cast<int>(args.GetInt("max-motions", sc_options.max_motions));
+  sc_options.refine_iterations = static_cast<int>(args.GetInt("refine", sc_options.refine_iterations));
+  sc_options.subspace_dimension = static_cast<int>(args.GetInt("subspace-dim", sc_options.subspace_dimension));
+  heading_keep_ratio = args.GetDouble("heading-keep-ratio", heading_keep_ratio);
+  if (const std::string problems = args.Problems(); !problems.empty()) {
+    std::fprintf(stderr, "mbslam-segment-tracks: %s\nusage: mbslam-segment-tracks --root DIR [--mode known_k|online|both] [--exclude NAME] [--only NAME]\n",
+                 problems.c_str());
+    return 2;
   }
   if (root.empty() || (mode != "known_k" && mode != "online" && mode != "both")) {
     std::fprintf(stderr, "mbslam-segment-tracks: --root DIR is required; --mode known_k|online|both\n");
