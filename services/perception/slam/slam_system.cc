@@ -27,6 +27,30 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr int kInitGridCols = 8;
 constexpr int kInitGridRows = 6;
 
+// A free essential matrix between normalised correspondences (RANSAC, inlier threshold
+// `thresh` in normalised units), with the correspondences as OpenCV points.
+struct EssentialFit {
+  std::vector<cv::Point2d> pr, pn;
+  cv::Mat E;     // empty (or not 3 rows) when none was found
+  cv::Mat mask;  // inliers
+  int inliers = 0;
+  bool ok() const { return !E.empty() && E.rows == 3; }
+};
+
+EssentialFit FitEssential(const std::vector<Eigen::Vector2d>& xr, const std::vector<Eigen::Vector2d>& xn,
+                          double thresh) {
+  EssentialFit fit;
+  fit.pr.resize(xr.size());
+  fit.pn.resize(xn.size());
+  for (size_t i = 0; i < xr.size(); ++i) {
+    fit.pr[i] = cv::Point2d(xr[i].x(), xr[i].y());
+    fit.pn[i] = cv::Point2d(xn[i].x(), xn[i].y());
+  }
+  fit.E = cv::findEssentialMat(fit.pr, fit.pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, fit.mask);
+  if (fit.ok()) fit.inliers = cv::countNonZero(fit.mask);
+  return fit;
+}
+
 }  // namespace
 
 const char* SlamStateName(SlamState state) {
@@ -794,11 +818,6 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
   }
 
   const size_t n = ids.size();
-  std::vector<cv::Point2d> pr(n), pn(n);
-  for (size_t i = 0; i < n; ++i) {
-    pr[i] = cv::Point2d(xr[i].x(), xr[i].y());
-    pn[i] = cv::Point2d(xn[i].x(), xn[i].y());
-  }
   // Candidate motions: from E (recoverPose), or from the homography decomposition
   // when the homography explains the views (planar scene or too little parallax), or,
   // when both views carry a rotation prior of one reference, the known rotation with
@@ -809,10 +828,14 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     cv::Mat mask;
   };
   std::vector<Candidate> candidates;
-  cv::Mat e_mask, h_mask;
-  cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, e_mask);
-  if (E.empty() || E.rows != 3) return InitAttempt::kRefusedGeometry;
-  const int e_inl = cv::countNonZero(e_mask);
+  const EssentialFit fit = FitEssential(xr, xn, thresh);
+  if (!fit.ok()) return InitAttempt::kRefusedGeometry;
+  const std::vector<cv::Point2d>& pr = fit.pr;
+  const std::vector<cv::Point2d>& pn = fit.pn;
+  const cv::Mat& E = fit.E;
+  const cv::Mat& e_mask = fit.mask;
+  const int e_inl = fit.inliers;
+  cv::Mat h_mask;
   int h_inl = 0;
   bool planar = false;
   // The body kept its rotation in the prior's frame when the known rotation explains
@@ -1157,17 +1180,10 @@ bool SlamSystem::RotationPriorHolds(const SlamFrame& frame, const std::unordered
     }
   }
   if (!ref) return true;  // nothing to test against: a later keyframe will tell
-  const size_t n = xr.size();
-  std::vector<cv::Point2d> pr(n), pn(n);
-  for (size_t i = 0; i < n; ++i) {
-    pr[i] = cv::Point2d(xr[i].x(), xr[i].y());
-    pn[i] = cv::Point2d(xn[i].x(), xn[i].y());
-  }
   const double thresh = 1.0 / frame.focal_px;
-  cv::Mat e_mask;
-  const cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, thresh, e_mask);
-  if (E.empty() || E.rows != 3) return true;
-  const int e_inl = cv::countNonZero(e_mask);
+  const EssentialFit fit = FitEssential(xr, xn, thresh);
+  if (!fit.ok()) return true;
+  const int e_inl = fit.inliers;
   const Eigen::Matrix3d R =
       (frame.rotation_prior->cam_from_ref * ref->rotation_prior->cam_from_ref.conjugate()).toRotationMatrix();
   const std::optional<KnownRotationTranslation> kt = TranslationGivenRotation(xr, xn, R, thresh, 200);
