@@ -201,6 +201,11 @@ TEST_F(RealDataCli, CamVidKnownAnswers) {
   EXPECT_DOUBLE_EQ(Get(j, "movable_features_labelled_moving"), 0.75);
   EXPECT_DOUBLE_EQ(Get(j, "moving_features"), 4);
   EXPECT_DOUBLE_EQ(Get(j, "frames"), 2);
+  // Bad options: the usage's exit status, not a crash or a silent default.
+  const std::string camvid = "camvid --root " + (dir_ / "camvid").string() + " --run " + (dir_ / "out.lcmlog").string();
+  EXPECT_EQ(RunCli(camvid + " --bogus 1", &j), 2);
+  EXPECT_EQ(RunCli(camvid + " --overlay-dir " + (dir_ / "ov").string() + " --overlay-every 2x", &j), 2);
+  EXPECT_FALSE(fs::exists(dir_ / "ov"));
 
   // The diagnostic dump: one line per scored feature with its truth class and its
   // distance to the nearest car / pedestrian / cyclist pixel (exact Euclidean, px).

@@ -119,7 +119,10 @@ int RunDavis(const CommandLineArgs& args) {
   const std::string overlay_dir = get("overlay-dir");
   const size_t overlay_every = static_cast<size_t>(std::max<int64_t>(1, args.GetInt("overlay-every", 1)));
   const std::string dump_path = get("dump"), sequences = get("sequences");
-  if (const std::string problems = args.Problems(); !problems.empty()) return Fail(problems);
+  if (const std::string problems = args.Problems(); !problems.empty()) {
+    std::fprintf(stderr, "mbslam-eval-realdata: %s\n", problems.c_str());
+    return Usage();
+  }
   if (root.empty() || runs.empty()) return Usage();
   std::ofstream dump;
   if (!dump_path.empty()) {
@@ -275,7 +278,10 @@ int RunCamVid(const CommandLineArgs& args) {
   const std::string root = get("root"), log = get("run");
   const size_t every = static_cast<size_t>(std::max<int64_t>(1, args.GetInt("overlay-every", 1)));
   const std::string dump_path = get("dump"), overlay_dir = get("overlay-dir");
-  if (const std::string problems = args.Problems(); !problems.empty()) return Fail(problems);
+  if (const std::string problems = args.Problems(); !problems.empty()) {
+    std::fprintf(stderr, "mbslam-eval-realdata: %s\n", problems.c_str());
+    return Usage();
+  }
   if (root.empty() || log.empty()) return Usage();
   std::vector<eval::CamVidFrame> frames;
   Status st = eval::ReadCamVid(root, &frames);
