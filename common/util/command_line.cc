@@ -39,10 +39,12 @@ std::vector<std::string> CommandLineArgs::GetAll(const std::string& key) const {
   return it == values_.end() ? std::vector<std::string>() : it->second;
 }
 
-double CommandLineArgs::GetDouble(const std::string& key, double fallback) const {
+template <typename T>
+T CommandLineArgs::GetNumber(const std::string& key, T fallback,
+                             Status (*parse)(const std::string&, const std::string&, T*)) const {
   if (!Has(key)) return fallback;
-  double value = fallback;
-  const Status st = ParseDouble(values_.at(key).back(), "--" + key, &value);
+  T value = fallback;
+  const Status st = parse(values_.at(key).back(), "--" + key, &value);
   if (!st.ok()) {
     if (bad_number_.empty()) bad_number_ = st.message();
     return fallback;
@@ -50,15 +52,12 @@ double CommandLineArgs::GetDouble(const std::string& key, double fallback) const
   return value;
 }
 
+double CommandLineArgs::GetDouble(const std::string& key, double fallback) const {
+  return GetNumber(key, fallback, &ParseDouble);
+}
+
 int64_t CommandLineArgs::GetInt(const std::string& key, int64_t fallback) const {
-  if (!Has(key)) return fallback;
-  int64_t value = fallback;
-  const Status st = ParseInt64(values_.at(key).back(), "--" + key, &value);
-  if (!st.ok()) {
-    if (bad_number_.empty()) bad_number_ = st.message();
-    return fallback;
-  }
-  return value;
+  return GetNumber(key, fallback, &ParseInt64);
 }
 
 std::string CommandLineArgs::ParseProblems() const { return !bad_.empty() ? bad_ : bad_number_; }

@@ -44,6 +44,11 @@ class CommandLineArgs {
   std::string ParseProblems() const;
 
  private:
+  // The value parsed by `parse`, or `fallback` (absent, or a problem when it does not parse).
+  template <typename T>
+  T GetNumber(const std::string& key, T fallback,
+              Status (*parse)(const std::string&, const std::string&, T*)) const;
+
   std::map<std::string, std::vector<std::string>> values_;
   mutable std::set<std::string> used_;
   std::string bad_;                  // a malformed command line

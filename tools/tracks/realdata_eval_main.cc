@@ -92,6 +92,13 @@ int Usage() {
   return 2;
 }
 
+// False (and the problem said) when an option is unknown or a number malformed.
+bool OptionsOk(const CommandLineArgs& args) {
+  const std::string problems = args.Problems();
+  if (!problems.empty()) std::fprintf(stderr, "mbslam-eval-realdata: %s\n", problems.c_str());
+  return problems.empty();
+}
+
 int Fail(const std::string& m) {
   std::fprintf(stderr, "mbslam-eval-realdata: %s\n", m.c_str());
   return 1;
@@ -114,15 +121,11 @@ int TrackedFrames(const std::string& log, const ChannelOptions& ch) {
 }
 
 int RunDavis(const CommandLineArgs& args) {
-  auto get = [&](const std::string& k) { return args.Get(k); };
-  const std::string root = get("root"), runs = get("runs"), per_frame_dir = get("per-frame-dir");
-  const std::string overlay_dir = get("overlay-dir");
+  const std::string root = args.Get("root"), runs = args.Get("runs"), per_frame_dir = args.Get("per-frame-dir");
+  const std::string overlay_dir = args.Get("overlay-dir");
   const size_t overlay_every = static_cast<size_t>(std::max<int64_t>(1, args.GetInt("overlay-every", 1)));
-  const std::string dump_path = get("dump"), sequences = get("sequences");
-  if (const std::string problems = args.Problems(); !problems.empty()) {
-    std::fprintf(stderr, "mbslam-eval-realdata: %s\n", problems.c_str());
-    return Usage();
-  }
+  const std::string dump_path = args.Get("dump"), sequences = args.Get("sequences");
+  if (!OptionsOk(args)) return Usage();
   if (root.empty() || runs.empty()) return Usage();
   std::ofstream dump;
   if (!dump_path.empty()) {
@@ -274,14 +277,10 @@ int RunDavis(const CommandLineArgs& args) {
 }
 
 int RunCamVid(const CommandLineArgs& args) {
-  auto get = [&](const std::string& k) { return args.Get(k); };
-  const std::string root = get("root"), log = get("run");
+  const std::string root = args.Get("root"), log = args.Get("run");
   const size_t every = static_cast<size_t>(std::max<int64_t>(1, args.GetInt("overlay-every", 1)));
-  const std::string dump_path = get("dump"), overlay_dir = get("overlay-dir");
-  if (const std::string problems = args.Problems(); !problems.empty()) {
-    std::fprintf(stderr, "mbslam-eval-realdata: %s\n", problems.c_str());
-    return Usage();
-  }
+  const std::string dump_path = args.Get("dump"), overlay_dir = args.Get("overlay-dir");
+  if (!OptionsOk(args)) return Usage();
   if (root.empty() || log.empty()) return Usage();
   std::vector<eval::CamVidFrame> frames;
   Status st = eval::ReadCamVid(root, &frames);
