@@ -226,11 +226,45 @@ Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
   return Status::Ok();
 }
 
+namespace {
+
+// Share of the finite points more than `band` below the plane.
+double BelowShare(const std::vector<Eigen::Vector3d>& points, const GroundPlane& plane, double band) {
+  int n = 0, below = 0;
+  for (const Eigen::Vector3d& p : points) {
+    if (!p.allFinite()) continue;
+    ++n;
+    below += plane.Height(p) < -band;
+  }
+  return n > 0 ? static_cast<double>(below) / static_cast<double>(n) : 0.0;
+}
+
+Status FitAlongTravel(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up_hint,
+                      const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& camera,
+                      const GroundPlaneOptions& options, GroundPlaneEstimate* estimate, bool* along_travel);
+
+}  // namespace
+
 Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up_hint,
                                       const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& camera,
                                       const GroundPlaneOptions& options, GroundPlaneEstimate* estimate,
                                       bool* along_travel) {
   if (estimate == nullptr || along_travel == nullptr) return Status::Error("EstimateGroundPlaneAlongTravel: null output");
+  MBSLAM_RETURN_IF_ERROR(FitAlongTravel(points, up_hint, centres, camera, options, estimate, along_travel));
+  const double below = BelowShare(points, estimate->plane, options.inlier_threshold);
+  if (below > options.max_below_share) {
+    *along_travel = false;
+    return Status::Error("EstimateGroundPlaneAlongTravel: " + std::to_string(below) +
+                         " of the points lie below the plane, above max_below_share");
+  }
+  return Status::Ok();
+}
+
+namespace {
+
+Status FitAlongTravel(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up_hint,
+                      const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& camera,
+                      const GroundPlaneOptions& options, GroundPlaneEstimate* estimate, bool* along_travel) {
   *along_travel = false;
   GroundPlaneEstimate free_fit;
   Status status = EstimateGroundPlane(points, up_hint, options, &free_fit);
@@ -290,6 +324,8 @@ Status EstimateGroundPlaneAlongTravel(const std::vector<Eigen::Vector3d>& points
   }
   return Status::Ok();
 }
+
+}  // namespace
 
 Status EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points,
                            const Eigen::Vector3d& up_hint, GroundPlaneEstimate* estimate) {

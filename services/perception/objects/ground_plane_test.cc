@@ -165,7 +165,8 @@ TEST(GroundPlane, AlongTravelRejectsASlopeThatOutnumbersTheGround) {
   EXPECT_GT(estimate.plane.normal.z(), 0.999);
   EXPECT_NEAR(estimate.plane.Height(camera), h, 0.005);
   // Travel too short even against the ground's height, along x: the slope contradicts
-  // it, so there is no plane. Along y (across the slope's tilt) the free fit stays.
+  // it, so there is no plane. Along y (across the slope's tilt) the travel does not, but
+  // the ground's points lie under the slope: no plane either ...
   std::vector<Eigen::Vector3d> short_travel, short_across;
   for (int k = 0; k < 12; ++k) {
     short_travel.emplace_back(0.002 * k, 0.0, 0.0);
@@ -173,6 +174,12 @@ TEST(GroundPlane, AlongTravelRejectsASlopeThatOutnumbersTheGround) {
   }
   EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_travel, short_travel.back(),
                                               options, &estimate, &along).ok());
+  EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_across, short_across.back(),
+                                              options, &estimate, &along).ok());
+  EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate,
+                                              &along).ok());
+  // ... unless points under the plane are allowed: then the free fit stays.
+  options.max_below_share = 1.0;
   ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_across, short_across.back(),
                                              options, &estimate, &along).ok());
   EXPECT_FALSE(along);
@@ -188,6 +195,33 @@ TEST(GroundPlane, AlongTravelRejectsASlopeThatOutnumbersTheGround) {
   options.min_support = 0.9;
   EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), centres, camera, options, &estimate,
                                               &along).ok());
+}
+
+// Nothing static lies under the ground: a plane with a share of the points below it
+// beyond max_below_share is refused, whatever its support; the ground under a scene with
+// a few points below it (noise, reflections) stays.
+TEST(GroundPlane, AlongTravelRefusesAPlaneWithPointsBelowIt) {
+  ParticleRng rng(3);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 500; ++i) points.emplace_back(rng.Uniform(-2, 2), rng.Uniform(1, 5), -1.0 + rng.Normal(0.0, 0.005));
+  for (int i = 0; i < 300; ++i) points.emplace_back(rng.Uniform(-2, 2), rng.Uniform(1, 5), rng.Uniform(-0.9, 1.0));
+  const int below = 50;  // 50 of 850: 5.9 %
+  for (int i = 0; i < below; ++i) points.emplace_back(rng.Uniform(-2, 2), rng.Uniform(1, 5), rng.Uniform(-1.5, -1.1));
+  GroundPlaneOptions options;
+  options.inlier_threshold_camera_heights = 0.0;
+  GroundPlaneEstimate estimate;
+  bool along = false;
+  const Eigen::Vector3d camera = Eigen::Vector3d::Zero();
+  ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate,
+                                             &along).ok());
+  EXPECT_NEAR(estimate.plane.Height(camera), 1.0, 0.01);
+  // 110 below of 910 (12.1 %): not the ground.
+  for (int i = 0; i < below + 10; ++i) points.emplace_back(rng.Uniform(-2, 2), rng.Uniform(1, 5), rng.Uniform(-1.5, -1.1));
+  const Status s = EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate, &along);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("below the plane"), std::string::npos) << s.message();
+  options.max_below_share = 0.13;
+  EXPECT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate, &along).ok());
 }
 
 // An up-to-scale map whose unit is large against the camera's height (0.03 units above
