@@ -69,6 +69,7 @@ inline constexpr const char* kImageSizeChanged = "image_size_changed";          
 inline constexpr const char* kImageWithoutOdometry = "image_without_odometry";  // odometry seen before, but none recent
 inline constexpr const char* kOdometryGap = "odometry_gap";                     // odometry resumed after a gap
 inline constexpr const char* kTrackingLost = "tracking_lost";                   // camera tracking state left OK
+inline constexpr const char* kWorldMotionReplaced = "world_motion_replaced";    // SLAM / odometry motion disagreed with the image: segmentation used its two-view estimate
 inline constexpr const char* kPoseEpipolarAssisted = "pose_epipolar_assisted";  // too few map points: pose leaned on the epipolar geometry (slam.hybrid_tracking)
 inline constexpr const char* kTrackingRecovered = "tracking_recovered";         // back to OK after a loss
 inline constexpr const char* kMapPointsCulled = "map_points_culled";            // left with their culled keyframes

@@ -612,6 +612,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
       };
     }
     seg = segmenter_.Update(in);
+    if (seg.world_motion_replaced) counters_->Increment(counter::kWorldMotionReplaced);
   }
   if (GetLogLevel() <= LogLevel::kDebug) {
     int moving = 0, unjudged = 0;

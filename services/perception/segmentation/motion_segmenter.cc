@@ -7,7 +7,9 @@
 
 #include <Eigen/SVD>
 
+#include "common/util/logging.h"
 #include "services/perception/geometry/polygon.h"
+#include "services/perception/geometry/rigid3.h"
 
 namespace mbslam {
 
@@ -153,9 +155,18 @@ void MotionSegmenter::UpdateHistories(const SegmenterInput& in) {
   }
 }
 
-std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput& in, int64_t ref, bool use_heading) {
-  if (in.world_motion) {
-    if (auto m = in.world_motion(ref, in.frame_index)) return m;
+std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput& in, int64_t ref, bool use_heading,
+                                                          bool* replaced) {
+  if (replaced) *replaced = false;
+  std::optional<RelativeMotion> given;
+  if (in.world_motion) given = in.world_motion(ref, in.frame_index);
+  // Checked for the reference image only (`replaced` given: the other pairs are shorter,
+  // their own estimate less certain); a map's motion only (odometry is a measurement of
+  // its own, with its noise in the envelope), and not when it was itself fitted to the
+  // tracks' epipolar geometry.
+  if (given && (!replaced || options_.world_check_trigger <= 0.0 || !given->translation_known ||
+                given->source != RelativeMotion::Source::kSlam || given->fitted_to_tracks)) {
+    return given;
   }
   std::vector<Eigen::Vector2d> xr, xn, xr_all, xn_all;
   for (const TrackObservation& o : in.observations) {
@@ -169,8 +180,17 @@ std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput&
       xn.push_back(o.xy);
     }
   }
+  // The caller's motion, checked on the tracks believed static (too few: taken as it is).
+  int given_inliers = 0;
+  if (given) {
+    if (static_cast<int>(xr.size()) < options_.world_min_tracks) return given;
+    const double threshold = options_.two_view.ransac_threshold_px / in.focal_px;
+    const Eigen::Matrix3d E = Hat(given->cam_n_from_cam_r.translation) * given->cam_n_from_cam_r.RotationMatrix();
+    for (size_t i = 0; i < xr.size(); ++i) given_inliers += std::abs(EpipolarDistance(E, xr[i], xn[i])) <= threshold;
+    if (given_inliers >= (1.0 - options_.world_check_trigger) * static_cast<double>(xr.size())) return given;
+  }
   // Until the static world is established, the dominant motion of all tracks is it.
-  if (!initialized_ || static_cast<int>(xr.size()) < options_.world_min_tracks) {
+  if (!given && (!initialized_ || static_cast<int>(xr.size()) < options_.world_min_tracks)) {
     xr = std::move(xr_all);
     xn = std::move(xn_all);
   }
@@ -178,7 +198,17 @@ std::optional<RelativeMotion> MotionSegmenter::WorldMotion(const SegmenterInput&
   std::vector<uint8_t> inliers;
   const Eigen::Vector3d* heading = use_heading && last_heading_ ? &*last_heading_ : nullptr;
   if (!EstimateRelativeMotion(xr, xn, in.focal_px, options_.two_view, &motion, &inliers, heading).ok()) {
-    return std::nullopt;
+    return given;
+  }
+  if (given) {
+    // A pure rotation explains any depth's tracks no better than the caller's motion: no
+    // evidence against it.
+    const int own_inliers = static_cast<int>(std::count(inliers.begin(), inliers.end(), uint8_t{1}));
+    if (!motion.translation_known || given_inliers >= options_.world_check_min_ratio * own_inliers) return given;
+    MBSLAM_LOG(DEBUG) << "segmentation frame " << in.frame_index << ": the world motion given for images " << ref
+                      << "-" << in.frame_index << " explains " << given_inliers << " of " << xr.size()
+                      << " static tracks, the two-view estimate " << own_inliers << ": the latter is used";
+    if (replaced) *replaced = true;
   }
   return motion;
 }
@@ -669,7 +699,9 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
   // young ones.
   int64_t ref = ChooseReference(in);
   if (ref < in.frame_index) {
-    std::optional<RelativeMotion> motion = WorldMotion(in, ref, /*use_heading=*/true);
+    bool replaced = false;
+    std::optional<RelativeMotion> motion = WorldMotion(in, ref, /*use_heading=*/true, &replaced);
+    result.world_motion_replaced = replaced;
     if (motion && !motion->translation_known && options_.translation_lag_tries > 0) {
       const int64_t earliest = EarliestReference(in);
       int64_t lag = in.frame_index - ref;
@@ -735,7 +767,9 @@ SegmentationResult MotionSegmenter::Update(const SegmenterInput& in) {
         }
       }
     }
-    result.long_baseline_tracks = UpdateLongBaseline(in, ref);
+    // The map's motions over the long baseline are no better than the one the image just
+    // contradicted.
+    if (!result.world_motion_replaced) result.long_baseline_tracks = UpdateLongBaseline(in, ref);
     UpdateObjectModels(in, ref);
     ClusterUnexplained(in, ref);
   }

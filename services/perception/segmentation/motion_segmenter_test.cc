@@ -106,6 +106,67 @@ TEST(MotionSegmenter, CrossingObjectIsSegmentedFromTwoViewMotion) {
   EXPECT_EQ(last.object_ids.size(), 1u) << "one object id for the one mover";
 }
 
+// A map's motion that disagrees with the image (its rotation 0.5 deg off per image, as a
+// drifted map or wrong intrinsics make it): the static tracks of large parallax leave
+// their epipolar lines and turn moving, unless the segmenter checks the motion against
+// its own two-view estimate and judges the image with that. A motion fitted to the tracks
+// (SLAM's epipolar-assisted poses) and an odometry motion are taken as they are.
+TEST(MotionSegmenter, AMapMotionTheImageContradictsIsReplaced) {
+  struct Run {
+    double static_moving_share = 0.0;
+    int replaced = 0;
+  };
+  auto run = [](double trigger, RelativeMotion::Source source, bool fitted) {
+    std::mt19937 rng(5);
+    Scene scene = MakeScene(&rng);
+    scene.object_points.clear();
+    scene.world_from_cam = [](int f) {
+      return Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.06 * f, 0.0, 0.03 * f));
+    };
+    scene.world_from_object = [](int) { return Rigid3d(); };
+    SegmentationOptions options;
+    options.world_check_trigger = trigger;
+    MotionSegmenter seg(options);
+    Run out;
+    int moving = 0, judged = 0;
+    for (int f = 0; f < 25; ++f) {
+      SegmenterInput in = scene.Observe(f, &rng);
+      in.world_motion = [&scene, source, fitted](int64_t r, int64_t n) -> std::optional<RelativeMotion> {
+        RelativeMotion m;
+        const Rigid3d error(Eigen::Matrix3d(Eigen::AngleAxisd(0.5 * M_PI / 180.0 * static_cast<double>(n - r),
+                                                              Eigen::Vector3d::UnitY())),
+                            Eigen::Vector3d::Zero());
+        m.cam_n_from_cam_r = error * scene.world_from_cam(static_cast<int>(n)).Inverse() *
+                             scene.world_from_cam(static_cast<int>(r));
+        m.covariance = Matrix6d::Identity() * 1e-8;
+        m.source = source;
+        m.fitted_to_tracks = fitted;
+        return m;
+      };
+      const SegmentationResult r = seg.Update(in);
+      out.replaced += r.world_motion_replaced;
+      if (f < 10) continue;
+      for (const TrackLabel& l : r.labels) {
+        judged += l.evaluated;
+        moving += l.evaluated && l.body_id != 0;
+      }
+    }
+    out.static_moving_share = judged > 0 ? static_cast<double>(moving) / judged : 1.0;
+    return out;
+  };
+  const Run checked = run(0.1, RelativeMotion::Source::kSlam, false);
+  const Run unchecked = run(0.0, RelativeMotion::Source::kSlam, false);
+  const Run fitted = run(0.1, RelativeMotion::Source::kSlam, true);
+  const Run odometry = run(0.1, RelativeMotion::Source::kOdometry, false);
+  EXPECT_GT(unchecked.static_moving_share, 0.2);
+  EXPECT_LT(checked.static_moving_share, 0.05);
+  EXPECT_GT(checked.replaced, 20);
+  EXPECT_EQ(unchecked.replaced, 0);
+  EXPECT_EQ(fitted.replaced, 0);
+  EXPECT_EQ(odometry.replaced, 0);
+  EXPECT_NEAR(fitted.static_moving_share, unchecked.static_moving_share, 1e-12);
+}
+
 // A robot following another robot (thesis sec. 3.5): the target moves along the
 // camera's own direction, so its points stay on their epipolar lines. With the world
 // motion and depth bounds from the map (as SLAM provides them), the FVB catches it.

@@ -26,6 +26,9 @@ struct RelativeMotion {
   bool translation_known = true;            // false: pure rotation (too little parallax)
   bool scale_known = false;                 // translation in the units of the depth bounds
   enum class Source { kSlam, kOdometry, kTwoView } source = Source::kTwoView;
+  // Fitted to the tracks' epipolar geometry already (SLAM's epipolar-assisted poses): the
+  // segmenter does not check it against its own two-view estimate.
+  bool fitted_to_tracks = false;
 };
 
 // A weighted sample of the motion distribution (sigma points of the covariance).

@@ -128,10 +128,11 @@ Status SlamSystem::LoadMap(const std::string& path) {
   return Status::Ok();
 }
 
-void SlamSystem::StorePose(int64_t frame, const Rigid3d& T, const Matrix6d& covariance) {
+void SlamSystem::StorePose(int64_t frame, const Rigid3d& T, const Matrix6d& covariance, bool epipolar_assisted) {
   FramePose p;
   p.cam_from_world = T;
   p.covariance = covariance;
+  p.epipolar_assisted = epipolar_assisted;
   if (const Keyframe* kf = map_.LastKeyframe()) {
     p.anchor_keyframe = kf->id;
     p.cam_from_anchor = T * kf->cam_from_world.Inverse();
@@ -451,7 +452,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     last_inliers_ = est.num_inliers;
     out.num_refound = 0;
     out.epipolar_assisted = assisted;
-    StorePose(frame.frame_index, est.cam_from_world, est.covariance);
+    StorePose(frame.frame_index, est.cam_from_world, est.covariance, assisted);
     // Published poses only: a confirming map's images are back-filled once it is
     // confirmed (or never, if it is dropped).
     if (out.valid) RecordTrajectory(frame.frame_index, est.cam_from_world, map_.LastKeyframe());
@@ -1487,6 +1488,7 @@ std::optional<RelativeMotion> SlamSystem::RelativeMotionBetween(int64_t ref, int
   m.translation_known = m.cam_n_from_cam_r.translation.norm() > 1e-9;
   m.scale_known = true;
   m.source = RelativeMotion::Source::kSlam;
+  m.fitted_to_tracks = r->second.epipolar_assisted || n->second.epipolar_assisted;
   return m;
 }
 

@@ -522,6 +522,7 @@ class SlamSystem {
     Matrix6d covariance;
     int64_t anchor_keyframe = -1;
     Rigid3d cam_from_anchor;    // cam_from_world * anchor.cam_from_world^-1
+    bool epipolar_assisted = false;  // TrackWithEpipolar's pose
   };
   std::map<int64_t, FramePose> recent_poses_;
   // Observations (track id, normalised xy) of recent images without a valid pose,
@@ -530,7 +531,8 @@ class SlamSystem {
   void RememberUnposed(const SlamFrame& frame);
   // A map was just confirmed with `frame`: poses of the unposed images before it.
   void BackfillPoses(int64_t frame, SlamPose* out);
-  void StorePose(int64_t frame, const Rigid3d& cam_from_world, const Matrix6d& covariance);
+  void StorePose(int64_t frame, const Rigid3d& cam_from_world, const Matrix6d& covariance,
+                 bool epipolar_assisted = false);
   // The current estimate of a recent frame's pose (following its anchor keyframe).
   std::optional<Rigid3d> PoseOf(int64_t frame) const;
   std::map<int64_t, Rigid3d> recent_odometry_;  // frame -> odom_from_cam
