@@ -27,6 +27,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/util/command_line.h"
 #include "services/perception/objects/bot_simulation.h"
 
 namespace mbslam {
@@ -230,43 +231,31 @@ struct Scenario {
 };
 
 int Run(int argc, char** argv) {
-  std::string out_dir = "out/bot_ablation";
-  std::string camera_name = "both";
-  int seeds = 5, particles = 1000;
-  double wiggle = 1.0, duration = 3.0;
-  bool noise_in_units = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool has_value = i + 1 < argc;
-    if (a == "--out" && has_value) {
-      out_dir = argv[++i];
-    } else if (a == "--seeds" && has_value) {
-      seeds = std::atoi(argv[++i]);
-    } else if (a == "--camera" && has_value) {
-      camera_name = argv[++i];
-    } else if (a == "--wiggle" && has_value) {
-      wiggle = std::atof(argv[++i]);
-    } else if (a == "--particles" && has_value) {
-      particles = std::atoi(argv[++i]);
-    } else if (a == "--duration" && has_value) {
-      duration = std::atof(argv[++i]);
-    } else if (a == "--noise-in-units") {
-      noise_in_units = true;
-    } else {
-      std::fprintf(
-          stderr,
-          "usage: mbslam-bot-ablation [--out DIR] [--seeds N] [--camera car|handheld|both] "
-          "[--wiggle S] [--particles N] [--duration S] [--noise-in-units]\n");
-      return 2;
-    }
+  const CommandLineArgs args(argc, argv);
+  const std::string out_dir = args.Get("out", "out/bot_ablation");
+  const std::string camera_name = args.Get("camera", "both");
+  const int64_t seeds_arg = args.GetInt("seeds", 5), particles_arg = args.GetInt("particles", 1000);
+  const double wiggle = args.GetDouble("wiggle", 1.0), duration = args.GetDouble("duration", 3.0);
+  const bool noise_in_units = args.Has("noise-in-units");
+  const std::string problems = args.Problems();
+  if (!problems.empty() || (args.Has("noise-in-units") && !args.Get("noise-in-units").empty())) {
+    std::fprintf(stderr, "mbslam-bot-ablation: %s\n",
+                 problems.empty() ? "--noise-in-units takes no value" : problems.c_str());
+    std::fprintf(
+        stderr,
+        "usage: mbslam-bot-ablation [--out DIR] [--seeds N] [--camera car|handheld|both] "
+        "[--wiggle S] [--particles N] [--duration S] [--noise-in-units]\n");
+    return 2;
   }
-  if (seeds < 1 || particles < 10 || duration < 2.0 || wiggle < 0.0 ||
+  if (seeds_arg < 1 || seeds_arg > 100000 || particles_arg < 10 || particles_arg > 10000000 || duration < 2.0 ||
+      wiggle < 0.0 ||
       (camera_name != "handheld" && camera_name != "car" && camera_name != "both")) {
     std::fprintf(stderr,
-                 "mbslam-bot-ablation: bad arguments (seeds >= 1, particles >= 10, "
+                 "mbslam-bot-ablation: bad arguments (seeds 1-100000, particles 10-10000000, "
                  "duration >= 2 s, wiggle >= 0, camera car|handheld|both)\n");
     return 2;
   }
+  const int seeds = static_cast<int>(seeds_arg), particles = static_cast<int>(particles_arg);
   BearingOnlyTrackerOptions tracker_options;
   tracker_options.num_particles = particles;
   // The process noise in units, as before depth-relative noise (for comparison).
