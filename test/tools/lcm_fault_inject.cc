@@ -12,11 +12,13 @@
 // Prints one line per edit; exit 0 on success, 2 on bad arguments, 1 on I/O errors.
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <string>
 
+#include "common/util/command_line.h"
 #include "test/tools/log_faults.h"
 
 namespace {
@@ -28,6 +30,28 @@ double SpecialValue(const std::string& s, bool* ok) {
   if (s == "-inf") return -std::numeric_limits<double>::infinity();
   *ok = false;
   return 0.0;
+}
+
+// One numeric argument of an edit, parsed whole (a malformed one is an error, not 0).
+bool Int(const char* text, const char* what, int64_t* value) {
+  const mbslam::Status s = mbslam::ParseInt64(text, what, value);
+  if (!s.ok()) std::fprintf(stderr, "lcm_fault_inject: %s\n", s.message().c_str());
+  return s.ok();
+}
+bool Int(const char* text, const char* what, int* value) {
+  int64_t v = 0;
+  if (!Int(text, what, &v)) return false;
+  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) {
+    std::fprintf(stderr, "lcm_fault_inject: %s: %s is out of range\n", what, text);
+    return false;
+  }
+  *value = static_cast<int>(v);
+  return true;
+}
+bool Real(const char* text, const char* what, double* value) {
+  const mbslam::Status s = mbslam::ParseDouble(text, what, value);
+  if (!s.ok()) std::fprintf(stderr, "lcm_fault_inject: %s\n", s.message().c_str());
+  return s.ok();
 }
 
 int Usage() {
@@ -54,37 +78,58 @@ int main(int argc, char** argv) {
     auto need = [&](int n) { return i + n < argc; };
     mbslam::Status st;
     bool ok = true;
+    int f1 = 0, f2 = 0, f3 = 0;  // frames, counts, sizes
+    int64_t t1 = 0, t2 = 0;      // times, seeds
+    double x = 0.0;
     if (a == "--drop-frames" && need(4)) {
-      const int n = editor.DropFrames(std::atof(argv[i + 1]), static_cast<uint32_t>(std::atol(argv[i + 4])),
-                                      std::atoi(argv[i + 2]), std::atoi(argv[i + 3]));
+      if (!Real(argv[i + 1], "--drop-frames FRACTION", &x) || !Int(argv[i + 2], "--drop-frames FIRST", &f1) ||
+          !Int(argv[i + 3], "--drop-frames END", &f2) || !Int(argv[i + 4], "--drop-frames SEED", &t1)) {
+        return Usage();
+      }
+      const int n = editor.DropFrames(x, static_cast<uint32_t>(t1), f1, f2);
       std::printf("dropped %d frames\n", n);
       i += 4;
     } else if (a == "--time-shift" && need(2)) {
-      st = editor.ShiftTime(std::atoi(argv[i + 1]), std::atoll(argv[i + 2]));
+      if (!Int(argv[i + 1], "--time-shift FRAME", &f1) || !Int(argv[i + 2], "--time-shift DELTA_US", &t1)) {
+        return Usage();
+      }
+      st = editor.ShiftTime(f1, t1);
       std::printf("time shifted by %s us from frame %s\n", argv[i + 2], argv[i + 1]);
       i += 2;
     } else if (a == "--drop-odometry" && need(2)) {
-      std::printf("dropped %d odometry messages\n",
-                  editor.DropOdometry(std::atoll(argv[i + 1]), std::atoll(argv[i + 2])));
+      if (!Int(argv[i + 1], "--drop-odometry FROM_US", &t1) || !Int(argv[i + 2], "--drop-odometry TO_US", &t2)) {
+        return Usage();
+      }
+      std::printf("dropped %d odometry messages\n", editor.DropOdometry(t1, t2));
       i += 2;
     } else if (a == "--corrupt-odometry" && need(3)) {
       const double v = SpecialValue(argv[i + 3], &ok);
-      if (!ok) return Usage();
-      std::printf("corrupted %d odometry messages\n",
-                  editor.CorruptOdometry(std::atoll(argv[i + 1]), std::atoll(argv[i + 2]), v));
+      if (!ok || !Int(argv[i + 1], "--corrupt-odometry FROM_US", &t1) ||
+          !Int(argv[i + 2], "--corrupt-odometry TO_US", &t2)) {
+        return Usage();
+      }
+      std::printf("corrupted %d odometry messages\n", editor.CorruptOdometry(t1, t2, v));
       i += 3;
     } else if (a == "--bad-calibration" && need(2)) {
       const double v = SpecialValue(argv[i + 2], &ok);
-      if (!ok) return Usage();
-      st = editor.InjectBadCalibration(std::atoi(argv[i + 1]), v);
+      if (!ok || !Int(argv[i + 1], "--bad-calibration FRAME", &f1)) return Usage();
+      st = editor.InjectBadCalibration(f1, v);
       std::printf("bad calibration before frame %s\n", argv[i + 1]);
       i += 2;
     } else if (a == "--resize-frame" && need(3)) {
-      st = editor.ResizeFrame(std::atoi(argv[i + 1]), std::atoi(argv[i + 2]), std::atoi(argv[i + 3]));
+      if (!Int(argv[i + 1], "--resize-frame FRAME", &f1) || !Int(argv[i + 2], "--resize-frame W", &f2) ||
+          !Int(argv[i + 3], "--resize-frame H", &f3)) {
+        return Usage();
+      }
+      st = editor.ResizeFrame(f1, f2, f3);
       std::printf("frame %s resized to %sx%s\n", argv[i + 1], argv[i + 2], argv[i + 3]);
       i += 3;
     } else if (a == "--burst" && need(3)) {
-      st = editor.Burst(std::atoi(argv[i + 1]), std::atoi(argv[i + 2]), std::atof(argv[i + 3]));
+      if (!Int(argv[i + 1], "--burst FIRST", &f1) || !Int(argv[i + 2], "--burst COUNT", &f2) ||
+          !Real(argv[i + 3], "--burst FACTOR", &x)) {
+        return Usage();
+      }
+      st = editor.Burst(f1, f2, x);
       std::printf("burst of %s frames at %sx from frame %s\n", argv[i + 2], argv[i + 3], argv[i + 1]);
       i += 3;
     } else {

@@ -19,6 +19,7 @@
 #include "mbslam/image_t.hpp"
 #include "mbslam/odometry_t.hpp"
 #include "common/lcm/wire_check.h"
+#include "common/util/command_line.h"
 
 namespace {
 
@@ -30,19 +31,22 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string out = argv[1];
-  int frames = 60, width = 320, height = 240;
-  bool faults = false;
-  for (int i = 2; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
-    else if (a == "--width" && i + 1 < argc) width = std::atoi(argv[++i]);
-    else if (a == "--height" && i + 1 < argc) height = std::atoi(argv[++i]);
-    else if (a == "--faults") faults = true;
-    else {
-      std::fprintf(stderr, "make_test_log: unknown argument %s\n", a.c_str());
-      return 2;
-    }
+  const mbslam::CommandLineArgs args(argc, argv, 2);
+  const int64_t frames_arg = args.GetInt("frames", 60), width_arg = args.GetInt("width", 320),
+                height_arg = args.GetInt("height", 240);
+  const bool faults = args.Has("faults");
+  const std::string problems = args.Problems();
+  if (!problems.empty() || !args.Get("faults").empty()) {
+    std::fprintf(stderr, "make_test_log: %s\n", problems.empty() ? "--faults takes no value" : problems.c_str());
+    return 2;
   }
+  if (frames_arg < 1 || frames_arg > 100000 || width_arg < 16 || width_arg > 8192 || height_arg < 16 ||
+      height_arg > 8192) {
+    std::fprintf(stderr, "make_test_log: --frames 1-100000, --width and --height 16-8192\n");
+    return 2;
+  }
+  const int frames = static_cast<int>(frames_arg), width = static_cast<int>(width_arg),
+            height = static_cast<int>(height_arg);
   mbslam::ChannelOptions ch;
   mbslam::Status status;
   auto log = mbslam::LcmLogWriter::Open(out, &status);

@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <string>
 
 
@@ -25,6 +26,7 @@
 #include "common/lcm/lcm_bus.h"
 #include "common/lcm/wire_check.h"
 #include "common/util/time.h"
+#include "common/util/command_line.h"
 #include "mbslam/camera_pose_t.hpp"
 #include "mbslam/map_t.hpp"
 #include "mbslam/objects_t.hpp"
@@ -46,16 +48,15 @@ double RssMb(int pid) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string url;
-  int pid = 0;
-  double seconds = 0.0, interval = 5.0;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    if (a == "--url") url = argv[i + 1];
-    else if (a == "--pid") pid = std::atoi(argv[i + 1]);
-    else if (a == "--seconds") seconds = std::atof(argv[i + 1]);
-    else if (a == "--interval") interval = std::atof(argv[i + 1]);
-    else return 2;
+  const mbslam::CommandLineArgs args(argc, argv);
+  const std::string url = args.Get("url");
+  const int64_t pid = args.GetInt("pid", 0);
+  const double seconds = args.GetDouble("seconds", 0.0), interval = args.GetDouble("interval", 5.0);
+  const std::string problems = args.Problems();
+  if (!problems.empty()) std::fprintf(stderr, "soak_monitor: %s\n", problems.c_str());
+  if (!problems.empty() || pid > std::numeric_limits<int>::max()) {
+    std::fprintf(stderr, "usage: soak_monitor --url URL --pid PID --seconds S [--interval S]\n");
+    return 2;
   }
   if (url.empty() || pid <= 0 || seconds <= 0.0 || interval <= 0.0) {
     std::fprintf(stderr, "usage: soak_monitor --url URL --pid PID --seconds S [--interval S]\n");
@@ -115,7 +116,7 @@ int main(int argc, char** argv) {
   while (true) {
     const int64_t now = mbslam::MonotonicUtime();
     if (now >= next) {
-      const double rss = RssMb(pid);
+      const double rss = RssMb(static_cast<int>(pid));
       if (rss < 0.0) break;
       auto mb = [](int64_t bytes) { return bytes < 0 ? -1.0 : static_cast<double>(bytes) / (1024.0 * 1024.0); };
       std::printf("%.1f,%.2f,%lld,%lld,%lld,%lld,%lld,%lld,%lld,%lld,%lld,%.3f,%.3f,%.3f\n", mbslam::UtimeToSeconds(now - start), rss,
