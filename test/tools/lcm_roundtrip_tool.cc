@@ -20,6 +20,7 @@
 #include "common/lcm/lcm_bus.h"
 #include "common/lcm/lcm_log.h"
 #include "common/lcm/wire_check.h"
+#include "common/util/command_line.h"
 #include "common/util/time.h"
 
 namespace {
@@ -53,8 +54,16 @@ int main(int argc, char** argv) {
   }
   const std::string mode = argv[1];
   const std::string target = argv[2];
-  const uint32_t seed = static_cast<uint32_t>(std::atoi(argv[3]));
-  const int repeats = std::atoi(argv[4]);
+  int64_t seed_arg = 0, repeats_arg = 0;
+  mbslam::Status parsed = mbslam::ParseInt64(argv[3], "SEED", &seed_arg);
+  if (parsed.ok()) parsed = mbslam::ParseInt64(argv[4], "REPEATS", &repeats_arg);
+  if (!parsed.ok() || seed_arg < 0 || seed_arg > 0xffffffffLL || repeats_arg < 1 || repeats_arg > 100000) {
+    std::fprintf(stderr, "lcm_roundtrip_tool: %s\n",
+                 parsed.ok() ? "SEED must be 0-4294967295, REPEATS 1-100000" : parsed.message().c_str());
+    return 2;
+  }
+  const uint32_t seed = static_cast<uint32_t>(seed_arg);
+  const int repeats = static_cast<int>(repeats_arg);
   const auto expected = MakeExpected(seed, repeats);
 
   if (mode == "write-log") {
@@ -91,7 +100,11 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (mode != "subscribe" || argc < 6) return 2;
-  const double timeout_s = std::atof(argv[5]);
+  double timeout_s = 0.0;
+  if (const mbslam::Status s = mbslam::ParseDouble(argv[5], "TIMEOUT_S", &timeout_s); !s.ok() || timeout_s <= 0.0) {
+    std::fprintf(stderr, "lcm_roundtrip_tool: %s\n", s.ok() ? "TIMEOUT_S must be positive" : s.message().c_str());
+    return 2;
+  }
   std::map<std::string, std::vector<std::vector<uint8_t>>> received;
   for (const auto& e : expected) {
     bus->Subscribe(e.channel, [&](const std::string& ch, const uint8_t* d, size_t n, int64_t) {
