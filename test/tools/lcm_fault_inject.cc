@@ -86,6 +86,10 @@ int main(int argc, char** argv) {
           !Int(argv[i + 3], "--drop-frames END", &f2) || !Int(argv[i + 4], "--drop-frames SEED", &t1)) {
         return Usage();
       }
+      if (t1 < 0 || t1 > 0xffffffffLL) {
+        std::fprintf(stderr, "lcm_fault_inject: --drop-frames SEED: %s is out of range (0-4294967295)\n", argv[i + 4]);
+        return Usage();
+      }
       const int n = editor.DropFrames(x, static_cast<uint32_t>(t1), f1, f2);
       std::printf("dropped %d frames\n", n);
       i += 4;

@@ -67,6 +67,9 @@ struct GroundPlaneOptions {
   // planes; on uncalibrated hand-held video (DAVIS) the planes fitted to a slope, a wall's
   // foot or a distorted reconstruction held 11-65 % under them, and their depth bound made
   // the far background break the flow bound (camel: 43 % of the features labelled moving).
+  // "Below" is measured with the world-unit band of the first fit (inlier_threshold), the
+  // one that decides min_support, not the narrowed band of a refit: only points clearly
+  // under the plane count, so the noise of a real ground does not.
   double max_below_share = 0.1;
   // Static points lie on or above the ground, so along a ray below the horizon a static
   // point is no deeper than where the ray meets the plane (the depth bound of the flow

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "services/perception/objects/random.h"
@@ -172,12 +173,17 @@ TEST(GroundPlane, AlongTravelRejectsASlopeThatOutnumbersTheGround) {
     short_travel.emplace_back(0.002 * k, 0.0, 0.0);
     short_across.emplace_back(0.0, 0.002 * k, 0.0);
   }
-  EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_travel, short_travel.back(),
-                                              options, &estimate, &along).ok());
-  EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_across, short_across.back(),
-                                              options, &estimate, &along).ok());
-  EXPECT_FALSE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate,
-                                              &along).ok());
+  Status s = EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_travel, short_travel.back(),
+                                            options, &estimate, &along);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("tilted"), std::string::npos) << s.message();
+  s = EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_across, short_across.back(), options,
+                                     &estimate, &along);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("below the plane"), std::string::npos) << s.message();
+  s = EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), {}, camera, options, &estimate, &along);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("below the plane"), std::string::npos) << s.message();
   // ... unless points under the plane are allowed: then the free fit stays.
   options.max_below_share = 1.0;
   ASSERT_TRUE(EstimateGroundPlaneAlongTravel(points, Eigen::Vector3d::UnitZ(), short_across, short_across.back(),

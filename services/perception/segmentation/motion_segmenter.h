@@ -91,9 +91,11 @@ struct SegmentationOptions {
   // poses (fitted to corner-like tracks already: a two-view estimate over every track,
   // edges that slide included, outvoted them on TartanAir's tile walls and the five-start
   // ATE rose 0.73 -> 1.21 %). The two-view estimate runs only when the map's motion leaves
-  // more than world_check_trigger of those tracks unexplained (0 = never check).
-  double world_check_trigger = 0.1;
-  double world_check_min_ratio = 0.8;
+  // more than world_check_trigger of those tracks unexplained (0 = never check). The
+  // young tracks' one-image pairs keep the map's motion (checked too, they made TartanAir
+  // worse: the one-image two-view estimate is the less certain one).
+  double world_check_trigger = 0.1;    // unexplained share of the static tracks that starts the check [0, 1]
+  double world_check_min_ratio = 0.8;  // the map's inliers below this share of the two-view's: replaced (0, 1]
   // Young tracks are judged over one image. A translating camera often moves too little
   // in one image for its translation to be measured, and the image-to-image motion comes
   // out as a pure rotation, under which every near static point's parallax is an error.
@@ -206,9 +208,9 @@ struct SegmentationOptions {
     v("world_min_tracks", &world_min_tracks, "static tracks to estimate the world motion (count)");
     v("world_min_p_static", &world_min_p_static, "P(static) for taking part in the world-motion RANSAC");
     v("world_check_trigger", &world_check_trigger,
-      "share of static tracks a map's world motion leaves unexplained that triggers its check against a two-view estimate (0 = never)");
+      "share of static tracks a map's world motion leaves unexplained that triggers its check against a two-view estimate [0, 1] (0 = never)");
     v("world_check_min_ratio", &world_check_min_ratio,
-      "a map's world motion is replaced when it explains fewer static tracks than this share of the two-view estimate's");
+      "a map's world motion is replaced when it explains fewer static tracks than this share of the two-view estimate's (0, 1]");
     v("translation_lag_tries", &translation_lag_tries,
       "a pure-rotation reference motion: references 2x, 4x ... as far back tried this often for a measurable translation (count)");
     v("young_heading_from_reference", &young_heading_from_reference,
