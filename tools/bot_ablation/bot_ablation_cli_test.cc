@@ -3,7 +3,6 @@
 // before any work; a small valid run writes its figures.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -11,25 +10,16 @@
 #include <filesystem>
 #include <string>
 
+#include "test/tools/run_command.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string Bin() {
-  const char* dir = std::getenv("MBSLAM_BIN_DIR");
-  return std::string(dir ? dir : "build/bin") + "/mbslam-bot-ablation";
-}
-
 // Runs the executable; its exit status, its stdout and stderr in `out`.
 int RunTool(const std::string& args, std::string* out) {
-  const std::string cmd = Bin() + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return -1;
-  out->clear();
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof(buf), pipe)) out->append(buf, n);
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return mbslam::testing_util::RunCommand(mbslam::testing_util::ToolPath("mbslam-bot-ablation") + " " + args + " 2>&1",
+                                          out);
 }
 
 class BotAblationCli : public ::testing::Test {

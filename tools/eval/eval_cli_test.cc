@@ -1,7 +1,6 @@
 // mbslam-eval end to end: files in, summary and a final JSON line out.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -20,6 +19,7 @@
 #include "mbslam/objects_t.hpp"
 #include "tools/eval/json.h"
 #include "tools/eval/trajectory.h"
+#include "test/tools/run_command.h"
 
 namespace mbslam {
 namespace eval {
@@ -27,33 +27,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Bin() {
-  const char* dir = std::getenv("MBSLAM_BIN_DIR");
-  return std::string(dir ? dir : "build/bin") + "/mbslam-eval";
-}
+std::string Bin() { return testing_util::ToolPath("mbslam-eval"); }
 
 // Runs a command; returns its exit status and the JSON object on its last stdout line.
 int RunEval(const std::string& args, Json* json) {
-  const std::string cmd = Bin() + " " + args + " 2>/dev/null";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) {
-    return -1;
-  }
   std::string out;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof(buf), pipe)) {
-    out.append(buf, n);
-  }
-  const int status = pclose(pipe);
-  while (!out.empty() && out.back() == '\n') {
-    out.pop_back();
-  }
-  const size_t nl = out.rfind('\n');
-  const std::string last = nl == std::string::npos ? out : out.substr(nl + 1);
-  if (json && !Json::Parse(last, json)) {
+  const int status = testing_util::RunCommand(Bin() + " " + args + " 2>/dev/null", &out);
+  if (json && !Json::Parse(testing_util::LastLine(out), json)) {
     *json = Json();
   }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return status;
 }
 
 class EvalCli : public ::testing::Test {

@@ -4,7 +4,6 @@
 #include "tools/occupancy_eval/occupancy_eval.h"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <opencv2/core.hpp>
@@ -24,6 +23,7 @@
 #include "services/perception/occupancy/occupancy_map.h"
 #include "tools/eval/json.h"
 #include "tools/eval/trajectory.h"
+#include "test/tools/run_command.h"
 
 namespace mbslam {
 namespace eval {
@@ -342,32 +342,15 @@ TEST(VoxelGrid, NeighbourhoodAndScore) {
 }
 
 // ---------------------------------------------------------------- the executable
-std::string Bin() {
-  const char* dir = std::getenv("MBSLAM_BIN_DIR");
-  return std::string(dir ? dir : "build/bin") + "/mbslam-eval-occupancy";
-}
+std::string Bin() { return testing_util::ToolPath("mbslam-eval-occupancy"); }
 
 int RunCli(const std::string& args, Json* json) {
-  const std::string cmd = Bin() + " " + args + " 2>/dev/null";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) {
-    return -1;
-  }
   std::string out;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof(buf), pipe)) {
-    out.append(buf, n);
-  }
-  const int status = pclose(pipe);
-  while (!out.empty() && out.back() == '\n') {
-    out.pop_back();
-  }
-  const size_t nl = out.rfind('\n');
-  const std::string last = nl == std::string::npos ? out : out.substr(nl + 1);
-  if (json && !Json::Parse(last, json)) {
+  const int status = testing_util::RunCommand(Bin() + " " + args + " 2>/dev/null", &out);
+  if (json && !Json::Parse(testing_util::LastLine(out), json)) {
     *json = Json();
   }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return status;
 }
 
 TEST_F(OccupancyEval, CommandLinePrintsTheJsonKeys) {

@@ -3,7 +3,6 @@
 
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -19,6 +18,7 @@
 #include "mbslam/camera_pose_t.hpp"
 #include "mbslam/objects_t.hpp"
 #include "mbslam/occupancy_t.hpp"
+#include "test/tools/run_command.h"
 
 namespace mbslam {
 namespace {
@@ -27,25 +27,11 @@ namespace fs = std::filesystem;
 
 constexpr int64_t kStart = 1600000000000000;
 
-std::string Bin() {
-  const char* dir = std::getenv("MBSLAM_BIN_DIR");
-  return std::string(dir ? dir : "build/bin") + "/planner_example";
-}
+std::string Bin() { return testing_util::ToolPath("planner_example"); }
 
 // Runs the executable; returns its exit status and its stdout.
 int RunPlanner(const std::string& args, std::string* out) {
-  const std::string cmd = Bin() + " " + args + " 2>/dev/null";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) {
-    return -1;
-  }
-  out->clear();
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof(buf), pipe)) {
-    out->append(buf, n);
-  }
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return testing_util::RunCommand(Bin() + " " + args + " 2>/dev/null", out);
 }
 
 // The static world: a wall x in [2.0, 2.1], y in [-1, 1], z in [0, 2], metres.

@@ -3,7 +3,6 @@
 // ../shared/data is absent).
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -25,6 +24,7 @@
 #include "tools/eval/datasets.h"
 #include "tools/eval/json.h"
 #include "tools/tracks/realdata_scoring.h"
+#include "test/tools/run_command.h"
 
 namespace mbslam {
 namespace eval {
@@ -32,24 +32,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Bin() {
-  const char* dir = std::getenv("MBSLAM_BIN_DIR");
-  return std::string(dir ? dir : "build/bin") + "/mbslam-eval-realdata";
-}
+std::string Bin() { return testing_util::ToolPath("mbslam-eval-realdata"); }
 
 int RunCli(const std::string& args, Json* json) {
-  const std::string cmd = Bin() + " " + args + " 2>/dev/null";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return -1;
   std::string out;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof(buf), pipe)) out.append(buf, n);
-  const int status = pclose(pipe);
-  while (!out.empty() && out.back() == '\n') out.pop_back();
-  const size_t nl = out.rfind('\n');
-  const std::string last = nl == std::string::npos ? out : out.substr(nl + 1);
-  if (!Json::Parse(last, json)) *json = Json();
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const int status = testing_util::RunCommand(Bin() + " " + args + " 2>/dev/null", &out);
+  if (!Json::Parse(testing_util::LastLine(out), json)) *json = Json();
+  return status;
 }
 
 double Get(const Json& j, const std::string& key) {
