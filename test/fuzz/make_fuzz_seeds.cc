@@ -28,6 +28,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/lcm/all_types.h"
+#include "common/util/command_line.h"
 #include "common/lcm/channels.h"
 #include "common/lcm/lcm_log.h"
 #include "common/lcm/wire_check.h"
@@ -361,7 +362,12 @@ int main(int argc, char** argv) {
       SeedsFromLog(argv[++i], &seeds);
     } else if (a == "--file" && i + 3 < argc) {
       const std::string target = argv[++i];
-      const int tag = std::atoi(argv[++i]);
+      int64_t tag = 0;
+      const mbslam::Status st = mbslam::ParseInt64(argv[++i], "--file TAG", &tag);
+      if (!st.ok() || tag > 255) {
+        std::fprintf(stderr, "make_fuzz_seeds: %s\n", st.ok() ? "--file TAG must be at most 255 (negative: untagged)" : st.message().c_str());
+        return 2;
+      }
       const std::string path = argv[++i];
       const Bytes bytes = ReadFile(path);
       seeds.Add(target, std::filesystem::path(path).stem().string(),

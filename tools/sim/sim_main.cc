@@ -11,10 +11,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
+#include <optional>
 #include <string>
 
 #include "common/config/options_yaml.h"
 #include "common/util/atomic_file.h"
+#include "common/util/command_line.h"
 #include "common/util/logging.h"
 #include "common/util/time.h"
 #include "tools/sim/gt_check.h"
@@ -82,9 +85,10 @@ static int Main(int argc, char** argv) {
   int check_frames = 10;
   // Command-line overrides, applied after the config file.
   std::string scenario, size;
-  int frames = -1, blur = -1;
-  double fps = -1.0, noise = -1.0;
-  int64_t seed = -1;
+  // Given on the command line: applied as given (the options' Check() refuses bad values).
+  std::optional<int> frames, blur;
+  std::optional<double> fps, noise;
+  std::optional<int64_t> seed;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -93,6 +97,34 @@ static int Main(int argc, char** argv) {
         std::exit(2);
       }
       return argv[++i];
+    };
+    // Numbers are read whole: "--frames 30x" or "--fps abc" is an error, not 30 or 0.
+    auto next_int = [&]() -> int64_t {
+      const std::string text = next();
+      int64_t v = 0;
+      const Status st = mbslam::ParseInt64(text, a, &v);
+      if (!st.ok()) {
+        std::cerr << "mbslam-sim: " << st.message() << "\n";
+        std::exit(2);
+      }
+      return v;
+    };
+    auto next_count = [&]() -> int {
+      const int64_t v = next_int();
+      if (v < 0 || v > std::numeric_limits<int>::max()) {
+        std::cerr << "mbslam-sim: " << a << " " << v << " is out of range\n";
+        std::exit(2);
+      }
+      return static_cast<int>(v);
+    };
+    auto next_double = [&]() -> double {
+      double v = 0.0;
+      const Status st = mbslam::ParseDouble(next(), a, &v);
+      if (!st.ok()) {
+        std::cerr << "mbslam-sim: " << st.message() << "\n";
+        std::exit(2);
+      }
+      return v;
     };
     if (a == "--list") {
       list = true;
@@ -105,17 +137,21 @@ static int Main(int argc, char** argv) {
     } else if (a == "--print-config") {
       print_config = true;
     } else if (a == "--frames") {
-      frames = std::atoi(next().c_str());
+      frames = next_count();
     } else if (a == "--size") {
       size = next();
     } else if (a == "--fps") {
-      fps = std::atof(next().c_str());
+      fps = next_double();
     } else if (a == "--seed") {
-      seed = std::atoll(next().c_str());
+      seed = next_int();
+      if (*seed < 0) {
+        std::cerr << "mbslam-sim: --seed " << *seed << " is negative\n";
+        return 2;
+      }
     } else if (a == "--noise") {
-      noise = std::atof(next().c_str());
+      noise = next_double();
     } else if (a == "--blur") {
-      blur = std::atoi(next().c_str());
+      blur = next_count();
     } else if (a == "--color") {
       writer.color_images = true;
     } else if (a == "--depth") {
@@ -129,7 +165,7 @@ static int Main(int argc, char** argv) {
     } else if (a == "--check") {
       check = true;
     } else if (a == "--check-frames") {
-      check_frames = std::atoi(next().c_str());
+      check_frames = next_count();
     } else if (a == "--quiet") {
       quiet = true;
     } else if (a == "--verbose") {
@@ -165,21 +201,11 @@ static int Main(int argc, char** argv) {
   if (!scenario.empty()) {
     options.scenario = scenario;
   }
-  if (frames > 0) {
-    options.num_frames = frames;
-  }
-  if (fps > 0.0) {
-    options.fps = fps;
-  }
-  if (seed >= 0) {
-    options.seed = seed;
-  }
-  if (noise >= 0.0) {
-    options.image.noise_sigma = noise;
-  }
-  if (blur > 0) {
-    options.image.motion_blur_samples = blur;
-  }
+  if (frames) options.num_frames = *frames;
+  if (fps) options.fps = *fps;
+  if (seed) options.seed = *seed;
+  if (noise) options.image.noise_sigma = *noise;
+  if (blur) options.image.motion_blur_samples = *blur;
   if (!size.empty() && !ParseSize(size, &options.camera.width, &options.camera.height)) {
     std::cerr << "mbslam-sim: --size wants WxH, got '" << size << "'\n";
     return 2;

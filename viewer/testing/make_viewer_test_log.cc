@@ -3,10 +3,12 @@
 //
 //   make_viewer_test_log OUT.lcmlog [--frames N] [--size WxH] [--jpeg] [--up-to-scale] [--faults]
 
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
+#include "common/util/command_line.h"
 #include "viewer/testing/synthetic_outputs.h"
 
 int main(int argc, char** argv) {
@@ -21,7 +23,14 @@ int main(int argc, char** argv) {
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--frames" && i + 1 < argc) {
-      options.frames = std::atoi(argv[++i]);
+      int64_t frames = 0;
+      const mbslam::Status st = mbslam::ParseInt64(argv[++i], "--frames", &frames);
+      if (!st.ok() || frames < 1 || frames > 100000) {
+        std::fprintf(stderr, "make_viewer_test_log: %s\n",
+                     st.ok() ? "--frames must be 1-100000" : st.message().c_str());
+        return 2;
+      }
+      options.frames = static_cast<int>(frames);
     } else if (a == "--size" && i + 1 < argc) {
       if (std::sscanf(argv[++i], "%dx%d", &options.width, &options.height) != 2) {
         std::fprintf(stderr, "make_viewer_test_log: --size needs WxH\n");
