@@ -73,7 +73,8 @@ out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float
        "ate_rmse_m": rmse, "ate_rel_path": rmse / length if (rmse is not None and length > 0) else None,
        "ate_rel_path_live": (json.loads(sys.argv[13] or "{}").get("ate_rmse_m") or 0) / length
                             if (json.loads(sys.argv[13] or "{}").get("ate_rmse_m") is not None and length > 0) else None,
-       "tracked_fraction": ate.get("fraction_tracked"), "sim3_scale": ate.get("scale"),
+       "tracked_fraction": ate.get("fraction_tracked"), "tracked_fraction_live": summary.get("tracked_fraction"),
+       "sim3_scale": ate.get("scale"),
        "moving_recall": seg.get("moving_recall"), "moving_precision": seg.get("moving_precision"),
        "false_moving_fraction": seg.get("false_moving_fraction"),
        "track_misclassification": seg.get("misclassification"),
@@ -118,7 +119,7 @@ if ate_nf:
     out["tracked_fraction_no_feedback"] = ate_nf.get("fraction_tracked")
 def pct(v):
     return "n/a" if v is None else f"{100*v:.3f} %"
-print(f"sim-{name}: ATE {pct(out['ate_rel_path'])} of {length:.2f} m (live poses {pct(out['ate_rel_path_live'])}), tracked {pct(out['tracked_fraction'])}, "
+print(f"sim-{name}: ATE {pct(out['ate_rel_path'])} of {length:.2f} m (live poses {pct(out['ate_rel_path_live'])}), tracked {pct(out['tracked_fraction'])} (live {pct(out['tracked_fraction_live'])}), "
       f"moving recall {out['moving_recall']}, precision {out['moving_precision']}, false moving {out['false_moving_fraction']}")
 if obj:
     print(f"  objects: {obj.get('est_objects')} estimated, {obj.get('matched')} matched of {obj.get('gt_bodies')}; "

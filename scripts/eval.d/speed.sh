@@ -121,7 +121,7 @@ def run_figures(d, n, rate):
         "frame_total_p99_ms": t.get("frame_total", {}).get("p99_ms"),
         "peak_rss_mb": round(rss_kb / 1024.0, 1) if rss_kb else None,
         "stage_overruns": c.get("stage_overrun", 0),
-        "tracked_fraction": s.get("tracked_fraction"),
+        "tracked_fraction_live": s.get("tracked_fraction"),
         "stages": {k: {"p50_ms": v.get("p50_ms"), "p99_ms": v.get("p99_ms"), "mean_ms": v.get("mean_ms")}
                    for k, v in t.items() if k not in ("latency",)},
     }
