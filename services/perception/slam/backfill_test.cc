@@ -35,13 +35,15 @@ struct Scene {
     }
   }
   static Eigen::Vector3d Center(int f) { return Eigen::Vector3d(0.04 * f, 0.0, 0.0); }
-  SlamFrame Frame(int f) const {
+  SlamFrame Frame(int f) const { return FrameAt(f, Center(f)); }
+  // Image f taken from `center` instead.
+  SlamFrame FrameAt(int f, const Eigen::Vector3d& center) const {
     SlamFrame frame;
     frame.frame_index = f;
     frame.utime = f * 33333;
     frame.focal_px = kFocal;
     for (size_t i = 0; i < points.size(); ++i) {
-      const Eigen::Vector3d p = points[i] - Center(f);
+      const Eigen::Vector3d p = points[i] - center;
       SlamObservation o;
       o.track_id = static_cast<int64_t>(i);
       o.xy = p.hnormalized();
@@ -175,6 +177,13 @@ TEST(SlamBackfill, ShortBaselineInitialisationWaitsForParallax) {
   // When a third of the tracks end just after the first acceptable pair, it goes ahead.
   options.init_wait_frames = 30;
   EXPECT_EQ(InitImage(scene, options, at_once, 200), at_once + 1);
+  // With init_wait_projection_frames the wait ends as soon as the parallax gained per
+  // image could not reach the good parallax in time (45 deg: after the 3 images judged),
+  // and lasts as long as before where it can (3 deg).
+  options.init_wait_projection_frames = 3;
+  EXPECT_EQ(InitImage(scene, options), at_once + 3);
+  options.init_good_parallax_deg = 3.0;
+  EXPECT_EQ(InitImage(scene, options), waited);
 }
 
 // The tracks of the `count` points nearest the camera.
@@ -252,16 +261,17 @@ TEST(SlamBackfill, AWaitingPairMakesTheMapWhenItsTracksEnd) {
   EXPECT_FALSE(off.next_posed);
 }
 
-// A later pair of the same reference that shows too little parallax contradicts the
-// waiting pair (its parallax came from something else): here the next image is the
-// reference image turned by 3 deg about the camera centre (no parallax at all). No map is
-// made from the waiting pair, then or when most tracks end in the image after.
-TEST(SlamBackfill, AWaitingPairContradictedByThePairAfterItIsDropped) {
+// Without init_wait_through_low_parallax a later pair of the same reference that shows
+// too little parallax drops the waiting pair: here the next image is the reference
+// image turned by 3 deg about the camera centre (no parallax at all). No map is made
+// from the waiting pair, then or when most tracks end in the image after.
+TEST(SlamBackfill, WithoutWaitingThroughLowParallaxAWaitingPairIsDropped) {
   const Scene scene(5);
   SlamOptions options;
   options.ba.time_limited = false;
   options.background_ba = false;
   options.init_good_parallax_deg = 0.0;
+  options.init_wait_through_low_parallax = false;
   const int at_once = InitImage(scene, options);
   ASSERT_GT(at_once, 0);
   const Eigen::Matrix3d R = Eigen::AngleAxisd(3.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -283,6 +293,65 @@ TEST(SlamBackfill, AWaitingPairContradictedByThePairAfterItIsDropped) {
   const WaitEnd end = EndWaitWith(scene, options, at_once, next, 2);
   EXPECT_EQ(end.second_keyframe, -1);
   EXPECT_FALSE(end.next_posed);
+}
+
+// A camera that sways back after the first acceptable pair (the images after it are
+// taken from 60 % of that pair's baseline, turned 2 deg: too little median parallax)
+// gives parallax back; that does not contradict the waiting pair
+// (SlamOptions::init_wait_through_low_parallax), which makes the map when its wait ends.
+// Without the option the first such image drops it, and no map is made.
+TEST(SlamBackfill, ParallaxGivenBackKeepsTheWaitingPair) {
+  const Scene scene(5);
+  SlamOptions options;
+  options.ba.time_limited = false;
+  options.background_ba = false;
+  options.init_good_parallax_deg = 0.0;
+  const int at_once = InitImage(scene, options);
+  ASSERT_GT(at_once, 0);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  auto swayed = [&](int f) {
+    SlamFrame frame = scene.FrameAt(f, 0.6 * Scene::Center(at_once));
+    for (SlamObservation& o : frame.observations) {
+      o.xy = (R * o.xy.homogeneous()).hnormalized();
+      o.uv = o.xy * kFocal + Eigen::Vector2d(320.0, 240.0);
+    }
+    return frame;
+  };
+  const int after = 8;
+  options.init_wait_through_low_parallax = true;
+  SlamOptions waiting = options;
+  waiting.init_good_parallax_deg = 45.0;  // never good enough: the pair at at_once waits
+  waiting.init_wait_frames = 5;
+  {
+    SlamSystem slam(waiting);
+    int64_t made_at = -1, second_keyframe = -1;
+    for (int f = 0; f <= at_once + after; ++f) {
+      const SlamFrame frame = f <= at_once ? scene.Frame(f) : swayed(f);
+      const SlamPose pose = slam.TrackPose(frame);
+      if (made_at < 0 && slam.map().num_keyframes() >= 2) {
+        made_at = f;
+        second_keyframe = std::next(slam.map().keyframes().begin())->second.frame_index;
+        EXPECT_TRUE(pose.valid);
+      }
+      std::unordered_map<int64_t, int> labels;
+      for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
+      slam.UpdateMap(frame, labels);
+    }
+    EXPECT_EQ(second_keyframe, at_once);
+    EXPECT_EQ(made_at, at_once + 5);
+  }
+  waiting.init_wait_through_low_parallax = false;
+  {
+    SlamSystem slam(waiting);
+    for (int f = 0; f <= at_once + after; ++f) {
+      const SlamFrame frame = f <= at_once ? scene.Frame(f) : swayed(f);
+      slam.TrackPose(frame);
+      std::unordered_map<int64_t, int> labels;
+      for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
+      slam.UpdateMap(frame, labels);
+    }
+    EXPECT_EQ(slam.map().num_keyframes(), 0u);
+  }
 }
 
 TEST(SlamBackfill, OffKeepsOnlyLivePoses) {

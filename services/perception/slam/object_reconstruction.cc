@@ -212,6 +212,12 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   // was no better on sim-multi's longest object map (trajectory 4.6 -> 4.0 %, shape
   // 53 -> 59 % of its size), so object maps keep the speed bridge.
   s.bridge_units = "speed";
+  // An object map from a short baseline is worse than a late one: its initialisation
+  // waits for parallax as it always did (with the world's early end of the wait,
+  // sim-crossing's longest object map went from 1.0 / 4.0 % to 11 / 109 % of its path /
+  // size).
+  s.init_wait_projection_frames = 0;
+  s.init_wait_through_low_parallax = false;
   // Nor do they take epipolar-assisted poses: an object's few, short tracks are what
   // runs out, not the texture (with them, sim-multi's longest object map: trajectory
   // 4.6 -> 10.8 %, shape 53 -> 646 % of its size).

@@ -683,11 +683,24 @@ void SlamSystem::BackfillPoses(int64_t frame, SlamPose* out) {
 bool SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   const InitAttempt attempt = AttemptInitialize(frame, out);
   if (attempt == InitAttempt::kDeferred) return false;
-  if (attempt == InitAttempt::kBuilt || attempt == InitAttempt::kRefusedGeometry || !options_.init_wait_fallback) {
+  if (attempt == InitAttempt::kRefusedParallax && init_pending_pair_ && options_.init_wait_through_low_parallax) {
+    // Parallax given back (a sideways sway): the waiting pair stands until its wait ends.
+    if (frame.frame_index - init_pending_frame_ < options_.init_wait_frames) return false;
+    const InitPair pair = std::move(*init_pending_pair_);
+    init_pending_pair_.reset();
+    MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << ": the wait for parallax ended, the pair of frames "
+                      << pair.ref_frame << "-" << pair.frame_index << " makes the map";
+    BuildInitialMap(pair, out);
+    return true;
+  }
+  if (attempt == InitAttempt::kBuilt || attempt == InitAttempt::kRefusedGeometry ||
+      attempt == InitAttempt::kRefusedParallax || !options_.init_wait_fallback) {
     // A pair of the same reference refused for its geometry (too little parallax, its
     // parallax inside moving objects) contradicts the waiting pair (the parallax that
     // had came from something else): the wait starts again.
-    if (init_pending_pair_ && attempt == InitAttempt::kRefusedGeometry) init_pending_frame_ = -1;
+    if (init_pending_pair_ && (attempt == InitAttempt::kRefusedGeometry || attempt == InitAttempt::kRefusedParallax)) {
+      init_pending_frame_ = -1;
+    }
     init_pending_pair_.reset();
     return false;
   }
@@ -830,7 +843,10 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
   };
   std::vector<Candidate> candidates;
   const EssentialFit fit = FitEssential(xr, xn, thresh);
-  if (!fit.ok()) return InitAttempt::kRefusedGeometry;
+  if (!fit.ok()) {
+    MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": no essential matrix";
+    return InitAttempt::kRefusedGeometry;
+  }
   const std::vector<cv::Point2d>& pr = fit.pr;
   const std::vector<cv::Point2d>& pn = fit.pn;
   const cv::Mat& E = fit.E;
@@ -864,9 +880,13 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     planar = h_inl >= options_.init_homography_ratio * e_inl;
     if (!planar) {
       cv::Mat R, t, mask = e_mask.clone();
-      if (cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask) <
-          options_.init_min_points) {
-        return InitAttempt::kRefusedGeometry;
+      // recoverPose counts only the points nearer than 50 baselines (parallax above about
+      // 1 deg): too few of them is a short baseline for the scene's depth.
+      const int in_front = cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask);
+      if (in_front < options_.init_min_points) {
+        MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": E inliers " << e_inl
+                          << ", H inliers " << h_inl << ", " << in_front << " in front of both views within 50 baselines";
+        return InitAttempt::kRefusedParallax;
       }
       Eigen::Matrix3d Re;
       Eigen::Vector3d te;
@@ -923,7 +943,10 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     // points counts against the waiting pair even where it is the tracks' lack (fewer
     // shared than a new start needs): made into the map then, TartanAir start 0's pair
     // of images 3-5 (58 points on a third of the image) drifted, ATE 0.67 -> 1.72 %.
-    return InitAttempt::kRefusedGeometry;
+    // Too little parallax (the baseline shrank, or has not grown yet) is told from the
+    // other refusals: it does not contradict a pair that waits for more.
+    const bool parallax_short = best && best->median_parallax < options_.init_min_parallax_deg * kDeg;
+    return parallax_short ? InitAttempt::kRefusedParallax : InitAttempt::kRefusedGeometry;
   }
   // The points that would make the map (those with parallax) must span the image too:
   // when the background only rotates, a followed object is all that has parallax.
@@ -978,8 +1001,16 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     if (init_pending_frame_ < 0) {
       init_pending_frame_ = frame.frame_index;
       init_pending_tracks_ = shared;
+      init_pending_parallax_ = best->median_parallax;
     }
-    if (frame.frame_index - init_pending_frame_ < options_.init_wait_frames &&
+    const int64_t waited = frame.frame_index - init_pending_frame_;
+    bool reachable = true;
+    if (options_.init_wait_projection_frames > 0 && waited >= options_.init_wait_projection_frames) {
+      const double rate = std::max(0.0, best->median_parallax - init_pending_parallax_) / static_cast<double>(waited);
+      reachable = best->median_parallax + rate * static_cast<double>(options_.init_wait_frames - waited) >=
+                  options_.init_good_parallax_deg * kDeg;
+    }
+    if (waited < options_.init_wait_frames && reachable &&
         shared >= options_.init_wait_keep_ratio * init_pending_tracks_) {
       MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << " deferred: median parallax "
                         << best->median_parallax / kDeg << " deg, " << shared << " of " << init_pending_tracks_
