@@ -465,7 +465,10 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   }
   ++frame_index_;
   frame_utime_[frame_index_] = frame.utime;
-  while (frame_utime_.size() > 64) frame_utime_.erase(frame_utime_.begin());
+  // As far back as the odometry motions of the segmentation reach, and as the poses SLAM
+  // may back-fill (their times are looked up here).
+  const size_t keep_utimes = 64 + static_cast<size_t>(std::max(0, options_.slam.backfill_max_frames));
+  while (frame_utime_.size() > keep_utimes) frame_utime_.erase(frame_utime_.begin());
 
   FrameResult result;
   result.utime = frame.utime;

@@ -104,8 +104,9 @@ struct SlamOptions {
   int init_wait_projection_frames = 0;
   // Images without a pose (before and during initialisation, while lost) are kept this
   // many at most; when a map is confirmed their poses are recovered against it (the
-  // trajectory files include them; the live pose stream cannot) (frames, <= 60; 0 = off).
-  int backfill_max_frames = 60;
+  // trajectory files include them; the live pose stream cannot) (frames, <= 300; 0 = off).
+  // About 24 bytes per track and image (1000 tracks: 2.9 MB for 120 images).
+  int backfill_max_frames = 120;
   double init_confirm_inlier_ratio = 0.7;  // inlier share required while confirming
   double triangulation_min_angle_deg = 1.0;  // new points need this parallax (deg)
   double triangulation_max_error_px = 2.0;   // ... and this reprojection error in both views (px)
@@ -211,7 +212,7 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION_GE(init_wait_frames, 0);
     MBSLAM_CHECK_OPTION_GE(init_wait_projection_frames, 0);
     MBSLAM_CHECK_OPTION(init_wait_keep_ratio >= 0.0 && init_wait_keep_ratio <= 1.0);
-    MBSLAM_CHECK_OPTION(backfill_max_frames >= 0 && backfill_max_frames <= 60);
+    MBSLAM_CHECK_OPTION(backfill_max_frames >= 0 && backfill_max_frames <= 300);
     MBSLAM_CHECK_OPTION(init_confirm_inlier_ratio > 0.0 && init_confirm_inlier_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GT(triangulation_min_angle_deg, 0.0);
     MBSLAM_CHECK_OPTION_GT(triangulation_max_error_px, 0.0);
@@ -270,7 +271,7 @@ struct SlamOptions {
       "(a pair refused for its geometry drops it)");
     v("backfill_max_frames", &backfill_max_frames,
       "images without a pose kept to recover their poses once a map is confirmed, for the trajectory "
-      "files (frames, <= 60; 0 = off)");
+      "files (frames, <= 300; 0 = off)");
     v("init_confirm_inlier_ratio", &init_confirm_inlier_ratio, "inlier share while confirming");
     v("triangulation_min_angle_deg", &triangulation_min_angle_deg, "parallax of new points (deg)");
     v("triangulation_max_error_px", &triangulation_max_error_px, "reprojection error of new points (px)");
