@@ -84,7 +84,10 @@ name, summary_path, length, ate = sys.argv[1], sys.argv[2], float(sys.argv[3]), 
 ate_live = json.loads(sys.argv[5] or "{}")
 s = json.load(open(summary_path))
 rmse = ate.get("ate_rmse_m")
-posed = round(s.get("posed_fraction", s["tracked_fraction"]), 4)
+# The file's share of the images, as mbslam-eval counts it for the simulated scenes (the
+# service's own count of the file, posed_fraction, when no ATE could be computed).
+scored = ate.get("fraction_tracked")
+posed = round(scored if scored is not None else s.get("posed_fraction", 0.0), 4)
 r = {"frames": s["frames"], "tracked_fraction": posed, "tracked_fraction_live": round(s["tracked_fraction"], 4),
      "posed_fraction": posed,
      "ate_rmse_m": rmse, "path_length_m": round(length, 3),

@@ -16,19 +16,20 @@ ate_se3=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$MBSLAM_EVAL_OUT/run/re
 seg=$(last_json "$MBSLAM_BIN/mbslam-eval-segmentation" --run "$MBSLAM_EVAL_OUT/run/out.lcmlog" --sequence "$seq" \
       --name robot_odometry || echo "{}")
 len=$(path_length "$seq/cam_trajectory.tum")
-python3 - "$ate" "$ate_se3" "$len" "$seg" <<'PY'
+python3 - "$ate" "$ate_se3" "$len" "$seg" "$MBSLAM_EVAL_OUT/run/result/summary.json" <<'PY'
 import json, sys
 ate, se3, length = json.loads(sys.argv[1]), json.loads(sys.argv[2]), float(sys.argv[3])
 seg = json.loads(sys.argv[4] or "{}")
+summary = json.load(open(sys.argv[5]))
 scale = ate.get("scale")
 out = {"scenario": "robot_odometry", "path_length_m": length,
        "scale_error": abs(scale - 1.0) if scale else None, "sim3_scale": scale,
        "ate_rel_path": ate["ate_rmse_m"] / length, "ate_se3_rmse_m": se3["ate_rmse_m"],
-       "tracked_fraction": ate.get("fraction_tracked"),
+       "tracked_fraction": ate.get("fraction_tracked"), "tracked_fraction_live": summary.get("tracked_fraction"),
        "moving_recall": seg.get("moving_recall"), "moving_precision": seg.get("moving_precision"),
        "false_moving_fraction": seg.get("false_moving_fraction")}
 print(f"sim-robot_odometry: metric scale error {100*out['scale_error']:.2f} %, ATE (Sim3) {100*out['ate_rel_path']:.3f} % of {length:.2f} m, "
-      f"ATE (SE3, metric) {se3['ate_rmse_m']:.4f} m, tracked {100*out['tracked_fraction']:.1f} %; moving recall "
+      f"ATE (SE3, metric) {se3['ate_rmse_m']:.4f} m, tracked {100*out['tracked_fraction']:.1f} % (live {100*out['tracked_fraction_live']:.1f} %); moving recall "
       f"{out['moving_recall']}, precision {out['moving_precision']}, false moving {out['false_moving_fraction']}")
 print(json.dumps(out))
 PY

@@ -691,7 +691,11 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   FillCameraPose(slam_pose, &result.camera_pose);
   for (const auto& [f, cam_from_world] : slam_pose.backfilled) {
     auto u = frame_utime_.find(f);
-    if (u == frame_utime_.end()) continue;
+    if (u == frame_utime_.end()) {
+      // Its image time is gone (kept for 64 + slam.backfill_max_frames images): said, not hidden.
+      MBSLAM_LOG(WARNING) << "back-filled pose of image " << f << " dropped: its time is no longer kept";
+      continue;
+    }
     Rigid3d world_from_cam = cam_from_world.Inverse();
     if (map_update.rescaled_by) world_from_cam.translation *= *map_update.rescaled_by;
     result.backfilled_camera_poses.emplace_back(u->second, world_from_cam);

@@ -340,6 +340,21 @@ TEST(SlamBackfill, ParallaxGivenBackKeepsTheWaitingPair) {
     EXPECT_EQ(second_keyframe, at_once);
     EXPECT_EQ(made_at, at_once + 5);
   }
+  {
+    // Back at the reference: too little image motion to judge a pair at all; the wait
+    // still ends init_wait_frames after the first acceptable pair.
+    SlamSystem slam(waiting);
+    int64_t made_at = -1;
+    for (int f = 0; f <= at_once + after; ++f) {
+      const SlamFrame frame = f <= at_once ? scene.Frame(f) : scene.FrameAt(f, Scene::Center(0));
+      slam.TrackPose(frame);
+      if (made_at < 0 && slam.map().num_keyframes() >= 2) made_at = f;
+      std::unordered_map<int64_t, int> labels;
+      for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
+      slam.UpdateMap(frame, labels);
+    }
+    EXPECT_EQ(made_at, at_once + 5);
+  }
   waiting.init_wait_through_low_parallax = false;
   {
     SlamSystem slam(waiting);

@@ -212,10 +212,10 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   // was no better on sim-multi's longest object map (trajectory 4.6 -> 4.0 %, shape
   // 53 -> 59 % of its size), so object maps keep the speed bridge.
   s.bridge_units = "speed";
-  // An object map from a short baseline is worse than a late one: its initialisation
-  // waits for parallax as it always did (with the world's early end of the wait,
-  // sim-crossing's longest object map went from 1.0 / 4.0 % to 11 / 109 % of its path /
-  // size).
+  // An object's initialisation waits for parallax as it always did: the world's changes
+  // to the wait (init_wait_through_low_parallax, init_wait_projection_frames) were
+  // measured on the world's map only (an object's few tracks, of which the nearest give
+  // the parallax, are not a hand-held view of a scene).
   s.init_wait_projection_frames = 0;
   s.init_wait_through_low_parallax = false;
   // Nor do they take epipolar-assisted poses: an object's few, short tracks are what

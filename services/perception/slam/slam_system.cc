@@ -144,7 +144,10 @@ void SlamSystem::StorePose(int64_t frame, const Rigid3d& T, const Matrix6d& cova
 void SlamSystem::RecordTrajectory(int64_t frame, const Rigid3d& T, const Keyframe* anchor) {
   if (options_.adjusted_trajectory_max_poses <= 0) return;
   auto u = frame_utime_.find(frame);
-  if (u == frame_utime_.end()) return;
+  if (u == frame_utime_.end()) {
+    MBSLAM_LOG(WARNING) << "SLAM: the pose of image " << frame << " is left out of the trajectory file: its time is no longer kept";
+    return;
+  }
   TrajectoryEntry e;
   e.frame = frame;
   e.utime = u->second;
@@ -443,7 +446,8 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     }
   }
   if (good) {
-    if (state_ == SlamState::kLost) state_ = SlamState::kTracking;
+    const bool recovered = state_ == SlamState::kLost;
+    if (recovered) state_ = SlamState::kTracking;
     lost_frames_ = 0;
     out.valid = state_ == SlamState::kTracking;
     out.cam_from_world = est.cam_from_world;
@@ -455,6 +459,9 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     StorePose(frame.frame_index, est.cam_from_world, est.covariance, assisted);
     // Published poses only: a confirming map's images are back-filled once it is
     // confirmed (or never, if it is dropped).
+    // Back on the same map after a loss: the images lost meanwhile are resected on it now
+    // (else they would wait, unposed, for the next map), before this one in time order.
+    if (recovered && out.valid) BackfillPoses(frame.frame_index, &out);
     if (out.valid) RecordTrajectory(frame.frame_index, est.cam_from_world, map_.LastKeyframe());
     if (out.valid && options_.adjusted_trajectory_refine_keyframes > 0 && options_.adjusted_trajectory_max_poses > 0) {
       RefineObservations& obs = refine_obs_[frame.frame_index];
@@ -682,10 +689,12 @@ void SlamSystem::BackfillPoses(int64_t frame, SlamPose* out) {
 
 bool SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   const InitAttempt attempt = AttemptInitialize(frame, out);
-  if (attempt == InitAttempt::kDeferred) return false;
-  if (attempt == InitAttempt::kRefusedParallax && init_pending_pair_ && options_.init_wait_through_low_parallax) {
-    // Parallax given back (a sideways sway): the waiting pair stands until its wait ends.
-    if (frame.frame_index - init_pending_frame_ < options_.init_wait_frames) return false;
+  // An image too close to the reference to judge (kDeferred), or one whose parallax was
+  // given back (a sideways sway, init_wait_through_low_parallax), leaves the waiting pair
+  // standing until its wait ends; then it makes the map and this image is tracked on it.
+  if (attempt == InitAttempt::kDeferred ||
+      (attempt == InitAttempt::kRefusedParallax && init_pending_pair_ && options_.init_wait_through_low_parallax)) {
+    if (!init_pending_pair_ || frame.frame_index - init_pending_frame_ < options_.init_wait_frames) return false;
     const InitPair pair = std::move(*init_pending_pair_);
     init_pending_pair_.reset();
     MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << ": the wait for parallax ended, the pair of frames "
@@ -695,9 +704,10 @@ bool SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   }
   if (attempt == InitAttempt::kBuilt || attempt == InitAttempt::kRefusedGeometry ||
       attempt == InitAttempt::kRefusedParallax || !options_.init_wait_fallback) {
-    // A pair of the same reference refused for its geometry (too little parallax, its
-    // parallax inside moving objects) contradicts the waiting pair (the parallax that
-    // had came from something else): the wait starts again.
+    // A pair of the same reference refused for its geometry (E or pose recovery failed,
+    // too few points), or, with init_wait_through_low_parallax off, for too little
+    // parallax, contradicts the waiting pair (the parallax that had came from something
+    // else): the wait starts again.
     if (init_pending_pair_ && (attempt == InitAttempt::kRefusedGeometry || attempt == InitAttempt::kRefusedParallax)) {
       init_pending_frame_ = -1;
     }
@@ -881,7 +891,8 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     if (!planar) {
       cv::Mat R, t, mask = e_mask.clone();
       // recoverPose counts only the points nearer than 50 baselines (parallax above about
-      // 1 deg): too few of them is a short baseline for the scene's depth.
+      // 1 deg): too few of them is a short baseline for the scene's depth (or an essential
+      // matrix that does not fit, which a consistent one a few images later replaces).
       const int in_front = cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask);
       if (in_front < options_.init_min_points) {
         MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": E inliers " << e_inl
@@ -945,7 +956,8 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     // of images 3-5 (58 points on a third of the image) drifted, ATE 0.67 -> 1.72 %.
     // Too little parallax (the baseline shrank, or has not grown yet) is told from the
     // other refusals: it does not contradict a pair that waits for more.
-    const bool parallax_short = best && best->median_parallax < options_.init_min_parallax_deg * kDeg;
+    const bool parallax_short = best && best->median_parallax < options_.init_min_parallax_deg * kDeg &&
+                                static_cast<int>(best->points.size()) >= options_.init_min_points;
     return parallax_short ? InitAttempt::kRefusedParallax : InitAttempt::kRefusedGeometry;
   }
   // The points that would make the map (those with parallax) must span the image too:
