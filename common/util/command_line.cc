@@ -1,5 +1,6 @@
 #include "common/util/command_line.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -89,6 +90,22 @@ Status ParseInt64(const std::string& text, const std::string& what, int64_t* val
     return Status::Error(what + ": '" + text + "' is not an integer");
   }
   *value = static_cast<int64_t>(v);
+  return Status::Ok();
+}
+
+Status ParseImageSize(const std::string& text, const std::string& what, int* width, int* height) {
+  const size_t x = text.find('x');
+  auto digits = [](const std::string& t) {
+    return !t.empty() && t.size() <= 5 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  int64_t w = 0, h = 0;
+  if (x == std::string::npos || !digits(text.substr(0, x)) || !digits(text.substr(x + 1)) ||
+      !ParseInt64(text.substr(0, x), what, &w).ok() || !ParseInt64(text.substr(x + 1), what, &h).ok() || w < 1 ||
+      h < 1 || w > 65535 || h > 65535) {
+    return Status::Error(what + ": '" + text + "' is not WxH (two whole numbers 1-65535)");
+  }
+  *width = static_cast<int>(w);
+  *height = static_cast<int>(h);
   return Status::Ok();
 }
 

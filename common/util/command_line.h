@@ -15,6 +15,8 @@ namespace mbslam {
 // (trailing text, empty, out of range, inf / nan).
 Status ParseDouble(const std::string& text, const std::string& what, double* value);
 Status ParseInt64(const std::string& text, const std::string& what, int64_t* value);
+// "WxH": two whole numbers 1-65535 and nothing else (e.g. 640x480).
+Status ParseImageSize(const std::string& text, const std::string& what, int* width, int* height);
 
 // The command line of the project's tools: `--key value` pairs and bare `--flag`s (a
 // flag is followed by another `--key` or by nothing; a value may start with a single

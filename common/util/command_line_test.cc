@@ -31,6 +31,20 @@ TEST(ParseNumberTest, WholeFiniteNumbersOnly) {
   EXPECT_FALSE(ParseInt64("99999999999999999999", "n", &i).ok());
 }
 
+TEST(ParseNumberTest, ImageSizesWhole) {
+  int w = 0, h = 0;
+  ASSERT_TRUE(ParseImageSize("640x480", "--size", &w, &h).ok());
+  EXPECT_EQ(w, 640);
+  EXPECT_EQ(h, 480);
+  for (const char* bad : {"", "640", "640x", "x480", "640x480junk", "64x48x2", "0x480", "640x0", "-640x480",
+                          "640x-480", "+640x480", " 640x480", "640x 480", "70000x480", "640X480", "6.5x4"}) {
+    const Status st = ParseImageSize(bad, "--size", &w, &h);
+    EXPECT_FALSE(st.ok()) << bad;
+    EXPECT_NE(st.message().find("--size"), std::string::npos) << bad;
+  }
+  EXPECT_EQ(w, 640) << "a refused size leaves the values";
+}
+
 TEST(CommandLineArgsTest, ValuesFlagsAndNegativeNumbers) {
   const CommandLineArgs args =
       Parse({"tool", "--in", "a.txt", "--verbose", "--scale", "-2.5", "--seed", "7", "--json"});

@@ -37,7 +37,9 @@ TEST(SimCli, MalformedNumbersAreRefusedBeforeAnyWork) {
   EXPECT_EQ(RunSim(base + " --frames 99999999999", &out), 2);
   EXPECT_NE(out.find("--frames"), std::string::npos) << out;
   EXPECT_EQ(RunSim(base + " --check-frames x", &out), 2);
-  // Well-formed but refused by the options (atoi made "0x" 0 and the override was skipped).
+  EXPECT_EQ(RunSim(base + " --size 64x48junk", &out), 2);
+  EXPECT_NE(out.find("--size"), std::string::npos) << out;
+  // Well-formed but refused by the options (a value <= 0 used to be skipped as 'not given').
   EXPECT_EQ(RunSim(base + " --frames 0", &out), 2);
   EXPECT_NE(out.find("num_frames"), std::string::npos) << out;
   EXPECT_EQ(RunSim(base + " --fps -5", &out), 2);

@@ -71,9 +71,6 @@ void Say(const char* format, ...) {
   va_end(args);
 }
 
-bool ParseSize(const std::string& text, int* w, int* h) {
-  return std::sscanf(text.c_str(), "%dx%d", w, h) == 2;
-}
 
 }  // namespace
 
@@ -206,9 +203,12 @@ static int Main(int argc, char** argv) {
   if (seed) options.seed = *seed;
   if (noise) options.image.noise_sigma = *noise;
   if (blur) options.image.motion_blur_samples = *blur;
-  if (!size.empty() && !ParseSize(size, &options.camera.width, &options.camera.height)) {
-    std::cerr << "mbslam-sim: --size wants WxH, got '" << size << "'\n";
-    return 2;
+  if (!size.empty()) {
+    const Status st = mbslam::ParseImageSize(size, "--size", &options.camera.width, &options.camera.height);
+    if (!st.ok()) {
+      std::cerr << "mbslam-sim: " << st.message() << "\n";
+      return 2;
+    }
   }
   if (!options.Check()) {
     std::cerr << "mbslam-sim: " << mbslam::LastOptionError() << "\n";

@@ -128,6 +128,7 @@ struct SimOptions {
 
   bool Check() const {
     MBSLAM_CHECK_OPTION(!scenario.empty());
+    MBSLAM_CHECK_OPTION_GE(seed, 0);
     MBSLAM_CHECK_OPTION_GE(num_frames, 1);
     MBSLAM_CHECK_OPTION_LE(num_frames, 100000);
     MBSLAM_CHECK_OPTION_GT(fps, 0.0);

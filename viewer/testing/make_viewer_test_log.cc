@@ -32,8 +32,9 @@ int main(int argc, char** argv) {
       }
       options.frames = static_cast<int>(frames);
     } else if (a == "--size" && i + 1 < argc) {
-      if (std::sscanf(argv[++i], "%dx%d", &options.width, &options.height) != 2) {
-        std::fprintf(stderr, "make_viewer_test_log: --size needs WxH\n");
+      const mbslam::Status st = mbslam::ParseImageSize(argv[++i], "--size", &options.width, &options.height);
+      if (!st.ok()) {
+        std::fprintf(stderr, "make_viewer_test_log: %s\n", st.message().c_str());
         return 2;
       }
     } else if (a == "--jpeg") {
