@@ -369,6 +369,38 @@ TEST(SlamBackfill, ParallaxGivenBackKeepsTheWaitingPair) {
   }
 }
 
+// With init_keep_best_pair the pair that waits is the acceptable one with most parallax:
+// when the camera sways back after image at_once + 2 (the images after it are taken from
+// image at_once's position, still acceptable, with less parallax), the map is made from
+// the pair of image at_once + 2 when the wait ends; without it, from the last image's.
+TEST(SlamBackfill, TheWaitingPairIsTheOneWithMostParallax) {
+  const Scene scene(5);
+  SlamOptions options;
+  options.ba.time_limited = false;
+  options.background_ba = false;
+  options.init_good_parallax_deg = 0.0;
+  const int at_once = InitImage(scene, options);
+  ASSERT_GT(at_once, 0);
+  options.init_good_parallax_deg = 45.0;  // never good enough: the pairs wait
+  options.init_wait_frames = 5;
+  auto second_keyframe_with = [&](bool keep_best) {
+    SlamOptions o = options;
+    o.init_keep_best_pair = keep_best;
+    SlamSystem slam(o);
+    for (int f = 0; f <= at_once + 8; ++f) {
+      const SlamFrame frame = f <= at_once + 2 ? scene.Frame(f) : scene.FrameAt(f, Scene::Center(at_once));
+      slam.TrackPose(frame);
+      if (slam.map().num_keyframes() >= 2) return std::next(slam.map().keyframes().begin())->second.frame_index;
+      std::unordered_map<int64_t, int> labels;
+      for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
+      slam.UpdateMap(frame, labels);
+    }
+    return int64_t{-1};
+  };
+  EXPECT_EQ(second_keyframe_with(true), at_once + 2);
+  EXPECT_EQ(second_keyframe_with(false), at_once + 5);
+}
+
 TEST(SlamBackfill, OffKeepsOnlyLivePoses) {
   const Scene scene(4);
   SlamOptions options;

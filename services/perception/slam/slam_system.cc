@@ -692,9 +692,12 @@ bool SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   // An image too close to the reference to judge (kDeferred), or one whose parallax was
   // given back (a sideways sway, init_wait_through_low_parallax), leaves the waiting pair
   // standing until its wait ends; then it makes the map and this image is tracked on it.
-  if (attempt == InitAttempt::kDeferred ||
+  if (attempt == InitAttempt::kDeferred || attempt == InitAttempt::kWaitEnded ||
       (attempt == InitAttempt::kRefusedParallax && init_pending_pair_ && options_.init_wait_through_low_parallax)) {
-    if (!init_pending_pair_ || frame.frame_index - init_pending_frame_ < options_.init_wait_frames) return false;
+    if (!init_pending_pair_ || (attempt != InitAttempt::kWaitEnded &&
+                                frame.frame_index - init_pending_frame_ < options_.init_wait_frames)) {
+      return false;
+    }
     const InitPair pair = std::move(*init_pending_pair_);
     init_pending_pair_.reset();
     MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << ": the wait for parallax ended, the pair of frames "
@@ -1027,8 +1030,16 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
       MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << " deferred: median parallax "
                         << best->median_parallax / kDeg << " deg, " << shared << " of " << init_pending_tracks_
                         << " tracks shared (acceptable since frame " << init_pending_frame_ << ")";
-      init_pending_pair_ = std::move(pair);
+      if (!options_.init_keep_best_pair || !init_pending_pair_ ||
+          pair.median_parallax_rad >= init_pending_pair_->median_parallax_rad) {
+        init_pending_pair_ = std::move(pair);
+      }
       return InitAttempt::kDeferred;
+    }
+    // The wait ends: an earlier pair with more parallax than this one makes the map.
+    if (options_.init_keep_best_pair && init_pending_pair_ &&
+        init_pending_pair_->median_parallax_rad > pair.median_parallax_rad) {
+      return InitAttempt::kWaitEnded;
     }
   }
 
