@@ -212,12 +212,6 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   // was no better on sim-multi's longest object map (trajectory 4.6 -> 4.0 %, shape
   // 53 -> 59 % of its size), so object maps keep the speed bridge.
   s.bridge_units = "speed";
-  // An object's initialisation waits for parallax as it always did: the world's changes
-  // to the wait (init_wait_through_low_parallax, init_wait_projection_frames) were
-  // measured on the world's map only (an object's few tracks, of which the nearest give
-  // the parallax, are not a hand-held view of a scene).
-  s.init_wait_projection_frames = 0;
-  s.init_wait_through_low_parallax = false;
   // Nor do they take epipolar-assisted poses: an object's few, short tracks are what
   // runs out, not the texture (with them, sim-multi's longest object map: trajectory
   // 4.6 -> 10.8 %, shape 53 -> 646 % of its size).
