@@ -95,8 +95,8 @@ struct SlamOptions {
   // The wait also ends once the parallax gained since the first acceptable pair, carried
   // on at the same rate, would not reach init_good_parallax_deg within init_wait_frames
   // (judged from init_wait_projection_frames of waiting on; 0 = wait the whole time): a
-  // camera driving straight ahead gains a few hundredths of a degree per image. Object
-  // maps never end their wait early. Measured with 3 (lockstep, seed 1): live poses
+  // camera driving straight ahead gains a few hundredths of a degree per image (object
+  // maps do not wait for parallax at all). Measured with 3 (lockstep, seed 1): live poses
   // sim-static 92.3 -> 96.0 %, following 83.3 -> 87.3 %, crossing 90 -> 94 % (seeds 2 / 3:
   // 89.7 -> 93.7 %, 90 -> 95 %), previously_static 91.7 -> 95.7 %, robot_odometry
   // 71.7 -> 75.7 % (scale error 1.06 -> 1.10 %), file ATE the same or lower; sim-multi,
