@@ -71,7 +71,6 @@ void Say(const char* format, ...) {
   va_end(args);
 }
 
-
 }  // namespace
 
 static int Main(int argc, char** argv) {

@@ -135,7 +135,8 @@ struct FrameResult {
   int64_t receive_wall_utime = 0;
   CameraPoseOutput camera_pose;
   // (utime, world_from_cam) of earlier images that had no pose, recovered when a map was
-  // confirmed with this image (SlamOptions::backfill_max_frames): for the trajectory
+  // confirmed with this image or tracking came back on it after a loss
+  // (SlamOptions::backfill_max_frames): for the trajectory
   // files only, the live pose stream having passed them.
   std::vector<std::pair<int64_t, Rigid3d>> backfilled_camera_poses;
   Eigen::Vector3d epipole = Eigen::Vector3d::Zero();

@@ -69,7 +69,7 @@ class ResultRecorder : public OutputSink {
   std::optional<OccupancyOutput> occupancy_;
   int64_t frames_ = 0;
   int64_t tracked_ = 0;     // images with a live pose (OK or relocalised)
-  int64_t backfilled_ = 0;  // earlier images whose pose was recovered when a map was confirmed
+  int64_t backfilled_ = 0;  // earlier images whose pose was recovered when a map was confirmed or tracking came back
   int64_t first_utime_ = 0;
   int64_t last_utime_ = 0;
 };

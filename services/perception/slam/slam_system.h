@@ -72,10 +72,11 @@ struct SlamOptions {
   double init_wait_keep_ratio = 0.8;     // wait only while this share of the first acceptable pair's tracks is still shared
   // The wait ends at the first image whose pair is refused for its tracks (fewer than
   // init_min_points shared with the reference, tracks or points that no longer span the
-  // image, or the reference expired): the last acceptable pair then makes the map, and
-  // that image is tracked on it. A pair refused for its geometry (too little parallax or
-  // too few points, E or pose recovery failed, parallax inside moving hulls) drops the
-  // waiting pair. So the fallback fires where tracks end abruptly or stop spanning the
+  // image, or the reference expired): the waiting pair (the last acceptable one, or the
+  // one with most parallax with init_keep_best_pair) then makes the map, and that image is
+  // tracked on it. A pair refused for its geometry (too few points, no essential matrix)
+  // drops the waiting pair, and so does one refused for too little parallax unless
+  // init_wait_through_low_parallax. So the fallback fires where tracks end abruptly or stop spanning the
   // image, not where they fade until too few points are left. Off: the waiting pair is
   // dropped whenever the wait ends without a map (short-lived tracks lose it).
   bool init_wait_fallback = true;
@@ -83,8 +84,9 @@ struct SlamOptions {
   // init_min_parallax_deg with init_min_points triangulated, or too few points within 50
   // baselines for the pose recovery) does not drop the waiting pair: a hand-held camera's
   // sideways sway takes parallax back as well as giving it. The wait still ends
-  // init_wait_frames after the first acceptable pair (also through images too close to
-  // the reference to judge), and the waiting pair then makes the map. sim-static's map
+  // init_wait_frames after the first acceptable pair, and the waiting pair then makes the
+  // map (so it does, whether this is on or off, through images too close to the reference
+  // to judge, which used to keep it waiting until the reference expired). sim-static's map
   // waited 47 images (acceptable pairs at 8, 13, 28 and 32, each dropped by a dip below
   // 1 deg): live poses 84 -> 92.3 % of the images; DAVIS: mean precision / recall / IoU
   // 59.1 / 76.8 / 31.5 -> 60.3 / 76.7 / 31.7 % (dance-twirl 66.7 -> 78.4 % precision, two
@@ -113,8 +115,9 @@ struct SlamOptions {
   // TartanAir (ten starts) and the other simulated scenes unchanged. Off: no clear gain.
   bool init_keep_best_pair = false;
   // Images without a pose (before and during initialisation, while lost) are kept this
-  // many at most; when a map is confirmed their poses are recovered against it (the
-  // trajectory files include them; the live pose stream cannot) (frames, <= 300; 0 = off).
+  // many at most; when a map is confirmed, or tracking comes back on the map after a loss,
+  // their poses are recovered against it (the trajectory files include them; the live
+  // pose stream cannot) (frames, <= 300; 0 = off).
   // About 24 bytes per track and image (1000 tracks: 2.9 MB for 120 images).
   int backfill_max_frames = 120;
   double init_confirm_inlier_ratio = 0.7;  // inlier share required while confirming
@@ -281,7 +284,7 @@ struct SlamOptions {
       "an image of the wait for parallax whose pair is refused for its tracks ends it: the waiting pair makes the map "
       "(a pair refused for its geometry drops it)");
     v("backfill_max_frames", &backfill_max_frames,
-      "images without a pose kept to recover their poses once a map is confirmed, for the trajectory "
+      "images without a pose kept to recover their poses once a map is confirmed or tracking comes back, for the trajectory "
       "files (frames, <= 300; 0 = off)");
     v("init_confirm_inlier_ratio", &init_confirm_inlier_ratio, "inlier share while confirming");
     v("triangulation_min_angle_deg", &triangulation_min_angle_deg, "parallax of new points (deg)");
@@ -379,8 +382,9 @@ struct SlamPose {
   std::vector<std::pair<int64_t, Eigen::Vector2f>> refound;
   int num_refound = 0;
   bool epipolar_assisted = false;          // the pose leaned on the epipolar geometry (too few map correspondences)
-  // When a map was confirmed with this image: poses of earlier images that had none
-  // (frame index, cam_from_world), recovered against the new map; in frame order.
+  // When a map was confirmed with this image, or tracking came back on it after a loss:
+  // poses of earlier images that had none (frame index, cam_from_world), recovered
+  // against the map; in frame order.
   std::vector<std::pair<int64_t, Rigid3d>> backfilled;
 };
 
@@ -500,12 +504,17 @@ class SlamSystem {
     double coverage = 0.0;
   };
   // TryInitialize's attempt on one image: kBuilt (a map); kDeferred (acceptable and
-  // waiting for parallax, or too little motion to try); refused for the pair's geometry
-  // (too little parallax, too few points) or for its tracks (too few shared with the
-  // reference, or not spanning the image).
+  // waiting for parallax, or too little motion to try); kWaitEnded (the wait ended and
+  // the waiting pair, with more parallax than this image's, is to make the map:
+  // init_keep_best_pair); refused for the pair's geometry (no essential matrix, too few
+  // points), for too little parallax (kRefusedParallax: median parallax below
+  // init_min_parallax_deg with enough points, or too few points within 50 baselines) or
+  // for its tracks (too few shared with the reference, not spanning the image, inside
+  // moving hulls).
   enum class InitAttempt { kRefusedGeometry, kRefusedParallax, kRefusedTracks, kDeferred, kWaitEnded, kBuilt };
-  // Returns true when a map was made from an earlier image's pair (init_pending_pair_)
-  // because this image's tracks made none: the image is then tracked on it.
+  // Returns true when a map was made from an earlier image's pair (init_pending_pair_):
+  // this image's tracks made none, or the wait for parallax ended; the image is then
+  // tracked on it.
   bool TryInitialize(const SlamFrame& frame, SlamPose* pose);
   InitAttempt AttemptInitialize(const SlamFrame& frame, SlamPose* pose);
   void BuildInitialMap(const InitPair& pair, SlamPose* pose);
