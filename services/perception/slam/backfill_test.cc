@@ -401,6 +401,56 @@ TEST(SlamBackfill, TheWaitingPairIsTheOneWithMostParallax) {
   EXPECT_EQ(second_keyframe_with(false), at_once + 5);
 }
 
+// Images lost while the map lasts (here the segmentation held every track moving in
+// images 25 and 26, so no static correspondence was left for tracking) are resected on
+// the same map when tracking comes back at image 27: their poses come with that image's,
+// before it, once each.
+TEST(SlamBackfill, ImagesLostWhileTheMapLastsArePosedWhenTrackingComesBack) {
+  const Scene scene(3);
+  SlamOptions options;
+  options.ba.time_limited = false;
+  options.background_ba = false;
+  options.hybrid_tracking = false;
+  SlamSystem slam(options);
+  std::map<int64_t, Rigid3d> backfilled;
+  int64_t recovered_at = -1;
+  bool tracking_before = false;
+  for (int f = 0; f < 32; ++f) {
+    SlamFrame frame = scene.Frame(f);
+    const bool held_moving = f == 25 || f == 26;
+    if (held_moving) {
+      for (SlamObservation& o : frame.observations) o.body_id = 1;
+    }
+    const SlamPose pose = slam.TrackPose(frame);
+    if (f == 24) tracking_before = pose.valid;
+    if (held_moving) EXPECT_FALSE(pose.valid) << "image " << f;
+    if (f > 26 && !pose.backfilled.empty()) {
+      EXPECT_EQ(recovered_at, -1) << "back-filled twice";
+      recovered_at = f;
+      for (const auto& [g, T] : pose.backfilled) {
+        EXPECT_TRUE(backfilled.emplace(g, T).second) << "image " << g << " twice";
+      }
+    }
+    std::unordered_map<int64_t, int> labels;
+    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;  // the map keeps its points
+    slam.UpdateMap(frame, labels);
+  }
+  ASSERT_TRUE(tracking_before);
+  EXPECT_EQ(recovered_at, 27);
+  ASSERT_EQ(backfilled.size(), 2u);
+  // Up to the map's gauge and scale: the recovered poses sit between their neighbours
+  // along the camera's straight path, one step apart.
+  const Eigen::Vector3d c25 = backfilled.at(25).Inverse().translation;
+  const Eigen::Vector3d c26 = backfilled.at(26).Inverse().translation;
+  EXPECT_GT((c26 - c25).norm(), 0.0);
+  const std::optional<Rigid3d> t24 = slam.PoseOfFrame(24);
+  ASSERT_TRUE(t24.has_value());
+  const Eigen::Vector3d c24 = t24->Inverse().translation;
+  const double step = (c25 - c24).norm();
+  EXPECT_NEAR((c26 - c25).norm(), step, 0.2 * step);
+  EXPECT_GT((c26 - c25).dot(c25 - c24), 0.0) << "same direction of travel";
+}
+
 TEST(SlamBackfill, OffKeepsOnlyLivePoses) {
   const Scene scene(4);
   SlamOptions options;
