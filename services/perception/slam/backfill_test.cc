@@ -423,7 +423,9 @@ TEST(SlamBackfill, ImagesLostWhileTheMapLastsArePosedWhenTrackingComesBack) {
     }
     const SlamPose pose = slam.TrackPose(frame);
     if (f == 24) tracking_before = pose.valid;
-    if (held_moving) EXPECT_FALSE(pose.valid) << "image " << f;
+    if (held_moving) {
+      EXPECT_FALSE(pose.valid) << "image " << f;
+    }
     if (f > 26 && !pose.backfilled.empty()) {
       EXPECT_EQ(recovered_at, -1) << "back-filled twice";
       recovered_at = f;
