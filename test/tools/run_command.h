@@ -11,14 +11,14 @@
 #include <cstdlib>
 #include <string>
 
+#include "test/drivers/process_util.h"
+
 namespace mbslam {
 namespace testing_util {
 
-// The executable `name` in $MBSLAM_BIN_DIR (set by CTest), else build/bin.
-inline std::string ToolPath(const std::string& name) {
-  const char* dir = std::getenv("MBSLAM_BIN_DIR");
-  return std::string(dir ? dir : "build/bin") + "/" + name;
-}
+// The executable `name`: $MBSLAM_BIN_DIR (set by CTest), else the build's bin folder
+// (BinPath of the driver tests).
+inline std::string ToolPath(const std::string& name) { return BinPath(name); }
 
 // Runs `command` through the shell; its exit status (-1 if it could not run or did not
 // exit), its stdout in `out`.

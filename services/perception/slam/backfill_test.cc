@@ -56,6 +56,13 @@ struct Scene {
   }
 };
 
+// The map is updated with every track of `frame` held static.
+void UpdateMapAllStatic(SlamSystem* slam, const SlamFrame& frame) {
+  std::unordered_map<int64_t, int> labels;
+  for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
+  slam->UpdateMap(frame, labels);
+}
+
 TEST(SlamBackfill, EarlierImagesGetTheirPosesWhenTheMapIsConfirmed) {
   const Scene scene(3);
   SlamOptions options;
@@ -73,9 +80,7 @@ TEST(SlamBackfill, EarlierImagesGetTheirPosesWhenTheMapIsConfirmed) {
       confirmed_at = f;
       for (const auto& [g, T] : pose.backfilled) backfilled[g] = T;
     }
-    std::unordered_map<int64_t, int> labels;
-    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
-    slam.UpdateMap(frame, labels);
+    UpdateMapAllStatic(&slam, frame);
   }
   ASSERT_GT(confirmed_at, 2);
   // Every image before the first live pose is back-filled, none twice.
@@ -126,9 +131,7 @@ TEST(SlamBackfill, AMapTheNextImageContradictsIsDropped) {
       dropped_at = f;
     }
     if (dropped_at >= 0 && f > dropped_at && pose.valid && confirmed_after_drop < 0) confirmed_after_drop = f;
-    std::unordered_map<int64_t, int> labels;
-    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
-    slam.UpdateMap(frame, labels);
+    UpdateMapAllStatic(&slam, frame);
   }
   ASSERT_GE(made_at, 0);
   EXPECT_EQ(dropped_at, made_at + 1);
@@ -148,9 +151,7 @@ int InitImage(const Scene& scene, const SlamOptions& options, int drop_after = 1
     }
     slam.TrackPose(frame);
     if (slam.map().num_keyframes() >= 2) return static_cast<int>(std::next(slam.map().keyframes().begin())->second.frame_index);
-    std::unordered_map<int64_t, int> labels;
-    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
-    slam.UpdateMap(frame, labels);
+    UpdateMapAllStatic(&slam, frame);
   }
   return -1;
 }
@@ -231,9 +232,7 @@ WaitEnd EndWaitWith(const Scene& scene, SlamOptions options, int at_once,
         out.second_keyframe = std::next(slam.map().keyframes().begin())->second.frame_index;
       }
     }
-    std::unordered_map<int64_t, int> labels;
-    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
-    slam.UpdateMap(frame, labels);
+    UpdateMapAllStatic(&slam, frame);
   }
   return out;
 }
@@ -333,9 +332,7 @@ TEST(SlamBackfill, ParallaxGivenBackKeepsTheWaitingPair) {
         second_keyframe = std::next(slam.map().keyframes().begin())->second.frame_index;
         EXPECT_TRUE(pose.valid);
       }
-      std::unordered_map<int64_t, int> labels;
-      for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
-      slam.UpdateMap(frame, labels);
+      UpdateMapAllStatic(&slam, frame);
     }
     EXPECT_EQ(second_keyframe, at_once);
     EXPECT_EQ(made_at, at_once + 5);
@@ -349,9 +346,7 @@ TEST(SlamBackfill, ParallaxGivenBackKeepsTheWaitingPair) {
       const SlamFrame frame = f <= at_once ? scene.Frame(f) : scene.FrameAt(f, Scene::Center(0));
       slam.TrackPose(frame);
       if (made_at < 0 && slam.map().num_keyframes() >= 2) made_at = f;
-      std::unordered_map<int64_t, int> labels;
-      for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
-      slam.UpdateMap(frame, labels);
+      UpdateMapAllStatic(&slam, frame);
     }
     EXPECT_EQ(made_at, at_once + 5);
   }
@@ -361,9 +356,7 @@ TEST(SlamBackfill, ParallaxGivenBackKeepsTheWaitingPair) {
     for (int f = 0; f <= at_once + after; ++f) {
       const SlamFrame frame = f <= at_once ? scene.Frame(f) : swayed(f);
       slam.TrackPose(frame);
-      std::unordered_map<int64_t, int> labels;
-      for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
-      slam.UpdateMap(frame, labels);
+      UpdateMapAllStatic(&slam, frame);
     }
     EXPECT_EQ(slam.map().num_keyframes(), 0u);
   }
@@ -391,9 +384,7 @@ TEST(SlamBackfill, TheWaitingPairIsTheOneWithMostParallax) {
       const SlamFrame frame = f <= at_once + 2 ? scene.Frame(f) : scene.FrameAt(f, Scene::Center(at_once));
       slam.TrackPose(frame);
       if (slam.map().num_keyframes() >= 2) return std::next(slam.map().keyframes().begin())->second.frame_index;
-      std::unordered_map<int64_t, int> labels;
-      for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
-      slam.UpdateMap(frame, labels);
+      UpdateMapAllStatic(&slam, frame);
     }
     return int64_t{-1};
   };
@@ -433,9 +424,7 @@ TEST(SlamBackfill, ImagesLostWhileTheMapLastsArePosedWhenTrackingComesBack) {
         EXPECT_TRUE(backfilled.emplace(g, T).second) << "image " << g << " twice";
       }
     }
-    std::unordered_map<int64_t, int> labels;
-    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;  // the map keeps its points
-    slam.UpdateMap(frame, labels);
+    UpdateMapAllStatic(&slam, frame);  // the map keeps its points
   }
   ASSERT_TRUE(tracking_before);
   EXPECT_EQ(recovered_at, 27);
@@ -540,9 +529,7 @@ StarvedRun RunStarved(bool hybrid, int min_tracking_inliers = 20, Patches patche
       const Eigen::Vector3d c = pose.cam_from_world.Inverse().translation / scale;
       run.worst_error = std::max(run.worst_error, (c - Scene::Center(f)).norm());
     }
-    std::unordered_map<int64_t, int> labels;
-    for (const SlamObservation& o : frame.observations) labels[o.track_id] = 0;
-    slam.UpdateMap(frame, labels);
+    UpdateMapAllStatic(&slam, frame);
   }
   return run;
 }

@@ -701,11 +701,7 @@ bool SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
                                 frame.frame_index - init_pending_frame_ < options_.init_wait_frames)) {
       return false;
     }
-    const InitPair pair = std::move(*init_pending_pair_);
-    init_pending_pair_.reset();
-    MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << ": the wait for parallax ended, the pair of frames "
-                      << pair.ref_frame << "-" << pair.frame_index << " makes the map";
-    BuildInitialMap(pair, out);
+    BuildWaitingPair(frame.frame_index, "the wait for parallax ended", out);
     return true;
   }
   if (attempt == InitAttempt::kBuilt || attempt == InitAttempt::kRefusedGeometry ||
@@ -724,12 +720,16 @@ bool SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
   // The wait for more parallax ended without a better pair (the shared tracks thinned
   // out or no longer span the image): the waiting pair makes the map, and this image is
   // tracked on it.
+  BuildWaitingPair(frame.frame_index, "no acceptable pair", out);
+  return true;
+}
+
+void SlamSystem::BuildWaitingPair(int64_t frame_index, const char* why, SlamPose* out) {
   const InitPair pair = std::move(*init_pending_pair_);
   init_pending_pair_.reset();
-  MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << ": no acceptable pair, the pair of frames "
-                    << pair.ref_frame << "-" << pair.frame_index << " (waiting for parallax) makes the map";
+  MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame_index << ": " << why << ", the pair of frames " << pair.ref_frame
+                    << "-" << pair.frame_index << " (waiting for parallax) makes the map";
   BuildInitialMap(pair, out);
-  return true;
 }
 
 SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, SlamPose* out) {

@@ -518,6 +518,8 @@ class SlamSystem {
   bool TryInitialize(const SlamFrame& frame, SlamPose* pose);
   InitAttempt AttemptInitialize(const SlamFrame& frame, SlamPose* pose);
   void BuildInitialMap(const InitPair& pair, SlamPose* pose);
+  // The pair waiting for parallax (init_pending_pair_, which must exist) makes the map.
+  void BuildWaitingPair(int64_t frame_index, const char* why, SlamPose* pose);
   // The rotation prior still explains the body's motion from the oldest keyframe that
   // shares init_min_points tracks with this frame (rotation_prior_keep_inlier_ratio).
   bool RotationPriorHolds(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const;
