@@ -9,14 +9,14 @@
 #include "common/lcm/all_types.h"
 #include "common/lcm/lcm_log.h"
 #include "common/lcm/wire_check.h"
+#include "common/testing/temp_dir.h"
 #include "common/util/logging.h"
 
 namespace mbslam {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  char pattern[] = "/tmp/mbslam_lcm_XXXXXX";
-  return std::string(mkdtemp(pattern)) + "/" + name;
+  return testing_util::MakeTestTempDir("lcm") + "/" + name;
 }
 
 struct Sample {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "common/testing/temp_dir.h"
 #include "common/util/atomic_file.h"
 #include "mbslam/pose_t.hpp"
 
@@ -10,8 +11,7 @@ namespace mbslam {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  char pattern[] = "/tmp/mbslam_log_XXXXXX";
-  return std::string(mkdtemp(pattern)) + "/" + name;
+  return testing_util::MakeTestTempDir("log") + "/" + name;
 }
 
 void WriteLog(const std::string& path) {

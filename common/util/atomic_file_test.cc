@@ -7,13 +7,12 @@
 #include <cstdlib>
 #include <string>
 
+#include "common/testing/temp_dir.h"
+
 namespace mbslam {
 namespace {
 
-std::string TempDir() {
-  char pattern[] = "/tmp/mbslam_atomic_XXXXXX";
-  return mkdtemp(pattern);
-}
+std::string TempDir() { return testing_util::MakeTestTempDir("atomic"); }
 
 TEST(AtomicFile, WritesAndReplaces) {
   const std::string path = TempDir() + "/f.txt";

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "common/lcm/wire_check.h"
+#include "common/testing/temp_dir.h"
 #include "mbslam/pose_t.hpp"
 
 namespace mbslam {
@@ -20,8 +21,7 @@ mbslam::pose_t MakePose(int64_t utime) {
 }
 
 TEST(MessageSink, LogSinkStampsEventsWithMessageTime) {
-  char pattern[] = "/tmp/mbslam_sink_XXXXXX";
-  const std::string path = std::string(mkdtemp(pattern)) + "/out.lcmlog";
+  const std::string path = testing_util::MakeTestTempDir("sink") + "/out.lcmlog";
   Status status;
   {
     std::unique_ptr<MessageSink> sink = CreateMessageSink(path, "", &status);

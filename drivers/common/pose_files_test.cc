@@ -5,13 +5,12 @@
 
 #include <fstream>
 
+#include "common/testing/temp_dir.h"
+
 namespace mbslam {
 namespace {
 
-std::string TempDir() {
-  char pattern[] = "/tmp/mbslam_pose_files_XXXXXX";
-  return mkdtemp(pattern);
-}
+std::string TempDir() { return testing_util::MakeTestTempDir("pose_files"); }
 
 void WriteText(const std::string& path, const std::string& text) {
   std::ofstream(path) << text;

@@ -3,22 +3,16 @@
 
 // Small helpers for the drivers' tests: temporary folders and text files.
 
-#include <stdlib.h>
-
 #include <fstream>
 #include <string>
-#include <vector>
+
+#include "common/testing/temp_dir.h"
 
 namespace mbslam {
 namespace testing_util {
 
-inline std::string MakeTempDir(const std::string& tag) {
-  std::string pattern = "/tmp/mbslam_" + tag + "_XXXXXX";
-  std::vector<char> buf(pattern.begin(), pattern.end());
-  buf.push_back('\0');
-  const char* dir = mkdtemp(buf.data());
-  return dir ? std::string(dir) : std::string();
-}
+// A new folder mbslam_<tag>_XXXXXX, removed when the test process exits.
+inline std::string MakeTempDir(const std::string& tag) { return MakeTestTempDir(tag); }
 
 inline void WriteTextFile(const std::string& path, const std::string& text) {
   std::ofstream(path) << text;

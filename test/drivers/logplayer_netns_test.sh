@@ -9,7 +9,7 @@ bin_dir=$1
 tests_dir=$2
 logplayer=${LCM_LOGPLAYER:-lcm-logplayer}
 command -v "$logplayer" >/dev/null || { echo "lcm-logplayer not installed; skipping" >&2; exit 77; }
-work=$(mktemp -d /tmp/mbslam_netns_XXXXXX)
+work=$(mktemp -d -t mbslam_netns_XXXXXX)
 trap 'rm -rf "$work"' EXIT
 
 # 60 BGR frames of 320x240 (230 kB each) at 20 Hz: 3 s of replay.
@@ -28,4 +28,6 @@ for _ in \$(seq 100); do [[ -e "$work/ready" ]] && break; sleep 0.05; done
 "$logplayer" --speed 1 -l "\$url" "$work/frames.lcmlog"
 wait \$receiver
 INSIDE
-exec test/netns/run_in_netns.sh bash "$work/inside.sh"
+# Not exec: the EXIT trap must still run to remove $work (the exit code, 77 included,
+# passes through set -e).
+test/netns/run_in_netns.sh bash "$work/inside.sh"

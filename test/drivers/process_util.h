@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "common/testing/temp_dir.h"
+
 namespace mbslam {
 namespace testing_util {
 
@@ -46,16 +48,15 @@ struct ProcessResult {
   std::string err;
 };
 
-// A child process with stdout and stderr going to temporary files.
+// A child process with stdout and stderr going to temporary files (read by Wait(),
+// removed by the destructor).
 class ChildProcess {
  public:
   explicit ChildProcess(const std::vector<std::string>& argv) {
-    char out_name[] = "/tmp/mbslam_proc_out_XXXXXX";
-    char err_name[] = "/tmp/mbslam_proc_err_XXXXXX";
-    const int out_fd = mkstemp(out_name);
-    const int err_fd = mkstemp(err_name);
-    out_path_ = out_name;
-    err_path_ = err_name;
+    out_path_ = TestTempRoot() + "/mbslam_proc_out_XXXXXX";
+    err_path_ = TestTempRoot() + "/mbslam_proc_err_XXXXXX";
+    const int out_fd = mkstemp(out_path_.data());
+    const int err_fd = mkstemp(err_path_.data());
     pid_ = fork();
     if (pid_ == 0) {
       dup2(out_fd, STDOUT_FILENO);
@@ -73,6 +74,10 @@ class ChildProcess {
   ChildProcess& operator=(const ChildProcess&) = delete;
   ~ChildProcess() {
     if (!waited_) Wait(0.0);
+    // Removed here, the one place every ChildProcess passes through (Wait() may run
+    // more than once or, through this destructor, never explicitly).
+    unlink(out_path_.c_str());
+    unlink(err_path_.c_str());
   }
 
   void Signal(int signal_number) { kill(pid_, signal_number); }
@@ -99,8 +104,6 @@ class ChildProcess {
     waited_ = true;
     result.out = ReadWholeFile(out_path_);
     result.err = ReadWholeFile(err_path_);
-    unlink(out_path_.c_str());
-    unlink(err_path_.c_str());
     return result;
   }
 

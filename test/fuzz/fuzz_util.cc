@@ -1,7 +1,5 @@
 #include "test/fuzz/fuzz_util.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +8,7 @@
 
 #include <opencv2/core/utils/logger.hpp>
 
+#include "common/testing/temp_dir.h"
 #include "common/util/logging.h"
 
 namespace mbslam {
@@ -45,16 +44,8 @@ ScratchDir& ScratchDir::Get() {
   return dir;
 }
 
-ScratchDir::ScratchDir() {
-  const char* tmp = std::getenv("TMPDIR");
-  std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/mbslam-fuzz-XXXXXX";
-  if (mkdtemp(pattern.data()) == nullptr) Fail("cannot create a scratch directory");
-  path_ = pattern;
-}
-
-ScratchDir::~ScratchDir() {
-  std::error_code ec;
-  std::filesystem::remove_all(path_, ec);
+ScratchDir::ScratchDir() : path_(testing_util::MakeTestTempDir("fuzz")) {
+  if (path_.empty()) Fail("cannot create a scratch directory");
 }
 
 std::string ScratchDir::Write(const std::string& name, const uint8_t* data, size_t size) {

@@ -25,7 +25,8 @@ struct Record {
 std::vector<Record> SplitRecords(const uint8_t* data, size_t size, size_t max_records = 64);
 void AppendRecord(uint8_t tag, const uint8_t* data, size_t size, std::vector<uint8_t>* out);
 
-// A directory private to this process, removed at exit, for readers that take paths.
+// A directory private to this process, removed at exit (common/testing/temp_dir.h),
+// for readers that take paths.
 // Write() replaces a file's content and returns its path.
 class ScratchDir {
  public:
@@ -38,7 +39,6 @@ class ScratchDir {
   // Creates an (empty) file or a folder below the scratch directory.
   std::string Touch(const std::string& name);
   std::string MakeDir(const std::string& name);
-  ~ScratchDir();
 
  private:
   ScratchDir();

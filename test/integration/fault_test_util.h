@@ -17,6 +17,7 @@
 #include "common/lcm/channels.h"
 #include "common/lcm/lcm_log.h"
 #include "common/lcm/wire_check.h"
+#include "common/testing/temp_dir.h"
 #include "mbslam/camera_pose_t.hpp"
 #include "mbslam/map_t.hpp"
 #include "mbslam/objects_t.hpp"
@@ -56,10 +57,9 @@ inline std::string EnsureSequence(std::string* error) {
   return dir;
 }
 
+// A new folder mbslam_<tag>_XXXXXX, removed when the test process exits.
 inline std::string MakeTempDir(const std::string& tag) {
-  std::string templ = "/tmp/mbslam_" + tag + "_XXXXXX";
-  char* made = ::mkdtemp(templ.data());
-  return made ? std::string(made) : std::string();
+  return testing_util::MakeTestTempDir(tag);
 }
 
 // Every event of an output log decodes as the type of its channel.

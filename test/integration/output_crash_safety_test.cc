@@ -21,6 +21,7 @@
 
 #include <octomap/OcTree.h>
 
+#include "common/testing/temp_dir.h"
 #include "common/util/atomic_file.h"
 #include "services/perception/pipeline/result_recorder.h"
 
@@ -269,10 +270,7 @@ class OutputCrashSafety : public ::testing::Test {
     versions_[1] = MakeVersion(1);
   }
   static void TearDownTestSuite() { delete[] versions_; }
-  static std::string TempDir() {
-    char pattern[] = "/tmp/mbslam_crash_XXXXXX";
-    return mkdtemp(pattern);
-  }
+  static std::string TempDir() { return testing_util::MakeTestTempDir("crash"); }
   static Version* versions_;
 };
 Version* OutputCrashSafety::versions_ = nullptr;

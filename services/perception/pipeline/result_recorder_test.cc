@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "common/testing/temp_dir.h"
 #include "common/util/atomic_file.h"
 
 namespace mbslam {
@@ -51,8 +52,7 @@ TEST(ResultRecorder, WritesTrackedPosesAndSummary) {
     FrameResult r = ImageResult(i, i == 0 ? TrackingState::kInitializing : TrackingState::kOk);
     recorder.OnFrameResult(r);
   }
-  char pattern[] = "/tmp/mbslam_rec_XXXXXX";
-  const std::string dir = mkdtemp(pattern);
+  const std::string dir = testing_util::MakeTestTempDir("rec");
   ASSERT_TRUE(recorder.Write(dir, "\"note\": 1").ok());
   std::string traj, summary;
   ASSERT_TRUE(ReadFileToString(dir + "/camera_trajectory.tum", &traj).ok());
@@ -81,8 +81,7 @@ TEST(ResultRecorder, BackfilledPosesGoInTimeOrder) {
     }
     recorder.OnFrameResult(r);
   }
-  char pattern[] = "/tmp/mbslam_rec_XXXXXX";
-  const std::string dir = mkdtemp(pattern);
+  const std::string dir = testing_util::MakeTestTempDir("rec");
   ASSERT_TRUE(recorder.Write(dir, "").ok());
   std::string summary;
   ASSERT_TRUE(ReadFileToString(dir + "/summary.json", &summary).ok());
@@ -107,8 +106,7 @@ TEST(ResultRecorder, AdjustedPosesReplaceLiveOnesOfTheSameImages) {
     adjusted.emplace_back(1000000 + i * 100000, p);
   }
   recorder.OnAdjustedCameraTrajectory(adjusted);
-  char pattern[] = "/tmp/mbslam_rec_XXXXXX";
-  const std::string dir = mkdtemp(pattern);
+  const std::string dir = testing_util::MakeTestTempDir("rec");
   ASSERT_TRUE(recorder.Write(dir, "").ok());
   EXPECT_EQ(TrajectoryX(dir + "/camera_trajectory.tum"), (std::vector<double>{0, 12, 3, 14}));
   EXPECT_EQ(TrajectoryX(dir + "/camera_trajectory_live.tum"), (std::vector<double>{0, 2, 3, 4}));
@@ -128,8 +126,7 @@ TEST(ResultRecorder, TrajectoriesAreBoundedOldestDropped) {
     r.objects.push_back(o);
     recorder.OnFrameResult(r);
   }
-  char pattern[] = "/tmp/mbslam_rec_XXXXXX";
-  const std::string dir = mkdtemp(pattern);
+  const std::string dir = testing_util::MakeTestTempDir("rec");
   ASSERT_TRUE(recorder.Write(dir, "").ok());
   std::string traj, summary, first_object;
   ASSERT_TRUE(ReadFileToString(dir + "/camera_trajectory.tum", &traj).ok());

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "common/testing/temp_dir.h"
+
 namespace mbslam {
 namespace {
 
@@ -21,8 +23,7 @@ TEST(Map, TracksPointsAndSaveLoadRoundTrip) {
   EXPECT_EQ(map.PointOfTrack(42), pid);
   map.ReleaseTrack(42);
   EXPECT_EQ(map.PointOfTrack(42), -1);
-  char dir[] = "/tmp/mbslam_map_XXXXXX";
-  const std::string path = std::string(mkdtemp(dir)) + "/map.txt";
+  const std::string path = testing_util::MakeTestTempDir("map") + "/map.txt";
   ASSERT_TRUE(map.Save(path).ok());
   Map loaded;
   ASSERT_TRUE(loaded.Load(path).ok());
