@@ -1,5 +1,7 @@
 // Poses of the images before a map exists (initialisation, confirmation) are recovered
-// against the new map once it is confirmed (SlamOptions::backfill_max_frames).
+// against the new map once it is confirmed (SlamOptions::backfill_max_frames); also
+// other tests of a map's life on the same synthetic scene (released tracks, hybrid
+// tracking).
 
 #include <gtest/gtest.h>
 
@@ -440,6 +442,55 @@ TEST(SlamBackfill, ImagesLostWhileTheMapLastsArePosedWhenTrackingComesBack) {
   const double step = (c25 - c24).norm();
   EXPECT_NEAR((c26 - c25).norm(), step, 0.2 * step);
   EXPECT_GT((c26 - c25).dot(c25 - c24), 0.0) << "same direction of travel";
+}
+
+// Track 0 slips at image 20 onto another feature, 0.8 m nearer along a nearby line of
+// sight, and follows it from then on: its point is released as an outlier of the pose.
+// Returns whether track 0 had a point just before the slip, and whether it got one again
+// by image 60.
+struct SlipRun {
+  bool mapped_before = false;
+  bool released = false;
+  bool mapped_again = false;
+};
+SlipRun RunSlip(bool stay_unmapped) {
+  Scene scene(5);
+  SlamOptions options;
+  options.ba.time_limited = false;
+  options.background_ba = false;
+  options.hybrid_tracking = false;
+  options.released_tracks_stay_unmapped = stay_unmapped;
+  SlamSystem slam(options);
+  const Eigen::Vector3d other = scene.points[0] * (1.0 - 0.8 / scene.points[0].z()) + Eigen::Vector3d(0.05, 0.0, 0.0);
+  SlipRun run;
+  for (int f = 0; f < 60; ++f) {
+    SlamFrame frame = scene.Frame(f);
+    if (f >= 20) {
+      SlamObservation& o = frame.observations[0];
+      o.xy = (other - Scene::Center(f)).hnormalized();
+      o.uv = o.xy * kFocal + Eigen::Vector2d(320.0, 240.0);
+    }
+    if (f == 19) run.mapped_before = slam.map().PointOfTrack(0) >= 0;
+    slam.TrackPose(frame);
+    if (f >= 20 && slam.map().PointOfTrack(0) < 0) run.released = true;
+    UpdateMapAllStatic(&slam, frame);
+    if (run.released && slam.map().PointOfTrack(0) >= 0) run.mapped_again = true;
+  }
+  return run;
+}
+
+TEST(SlamReleasedTracks, ATrackThatDriftedOffItsPointIsNotTriangulatedAgain) {
+  const SlipRun run = RunSlip(/*stay_unmapped=*/true);
+  ASSERT_TRUE(run.mapped_before);
+  ASSERT_TRUE(run.released);
+  EXPECT_FALSE(run.mapped_again);
+}
+
+TEST(SlamReleasedTracks, WithoutTheOptionItGetsANewPoint) {
+  const SlipRun run = RunSlip(/*stay_unmapped=*/false);
+  ASSERT_TRUE(run.mapped_before);
+  ASSERT_TRUE(run.released);
+  EXPECT_TRUE(run.mapped_again);  // the feature it follows now is a consistent static point
 }
 
 TEST(SlamBackfill, OffKeepsOnlyLivePoses) {

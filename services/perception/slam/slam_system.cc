@@ -502,6 +502,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
       } else {
         p->released_frame = frame.frame_index;
         map_.ReleaseTrack(tracks[i]);  // the track drifted off its point
+        if (options_.released_tracks_stay_unmapped) released_tracks_[tracks[i]] = frame.frame_index;
       }
     }
   } else {
@@ -1290,9 +1291,23 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
     trajectory_.back().cam_from_anchor = Rigid3d();
   }
   const double max_err = options_.triangulation_max_error_px / frame.focal_px;
-  int tracked = 0, unseen = 0, degenerate = 0, low_parallax = 0, reprojection = 0;
+  int tracked = 0, unseen = 0, degenerate = 0, low_parallax = 0, reprojection = 0, released = 0;
+  if (!released_tracks_.empty()) {
+    for (const auto& [track, x] : k.track_xy) {
+      auto it = released_tracks_.find(track);
+      if (it != released_tracks_.end()) it->second = frame.frame_index;
+    }
+    // Tracks not seen for a while have ended (track ids are never reused).
+    for (auto it = released_tracks_.begin(); it != released_tracks_.end();) {
+      it = frame.frame_index - it->second > 4 * options_.keyframe_max_frames ? released_tracks_.erase(it) : std::next(it);
+    }
+  }
   for (const auto& [track, x] : k.track_xy) {
     const int64_t pid = map_.PointOfTrack(track);
+    if (pid < 0 && released_tracks_.count(track)) {
+      ++released;
+      continue;
+    }
     if (pid >= 0) {
       const MapPoint* p = map_.point(pid);
       if (ReprojectionError(T, p->position, x) <= 2.0 * max_err) {
@@ -1347,7 +1362,7 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
   MBSLAM_LOG(DEBUG) << "SLAM keyframe at image " << frame.frame_index << ": " << k.track_xy.size() << " static tracks, "
                     << tracked << " on points, " << update->new_point_ids.size() << " new points; not triangulated: "
                     << unseen << " unseen by the last keyframes, " << degenerate << " degenerate, " << low_parallax
-                    << " low parallax, " << reprojection << " reprojection";
+                    << " low parallax, " << reprojection << " reprojection, " << released << " released before";
   last_keyframe_frame_ = frame.frame_index;
   update->new_keyframe = true;
   update->culled_points = CullKeyframes(frame.frame_index);

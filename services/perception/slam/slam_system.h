@@ -123,6 +123,10 @@ struct SlamOptions {
   double init_confirm_inlier_ratio = 0.7;  // inlier share required while confirming
   double triangulation_min_angle_deg = 1.0;  // new points need this parallax (deg)
   double triangulation_max_error_px = 2.0;   // ... and this reprojection error in both views (px)
+  // A track released from its point as an outlier of the pose ("drifted off its point")
+  // is never triangulated again while it lives: a feature sliding along an outline keeps
+  // drifting and would make a new wrong point at each keyframe.
+  bool released_tracks_stay_unmapped = false;
   int keyframe_min_frames = 3;           // frames between keyframes at least (frames)
   int keyframe_max_frames = 20;          // a keyframe at least this often while tracking (frames)
   double keyframe_tracked_ratio = 0.75;  // fewer tracked map points than this share of the last keyframe's: new keyframe
@@ -289,6 +293,8 @@ struct SlamOptions {
     v("init_confirm_inlier_ratio", &init_confirm_inlier_ratio, "inlier share while confirming");
     v("triangulation_min_angle_deg", &triangulation_min_angle_deg, "parallax of new points (deg)");
     v("triangulation_max_error_px", &triangulation_max_error_px, "reprojection error of new points (px)");
+    v("released_tracks_stay_unmapped", &released_tracks_stay_unmapped,
+      "a track released from its point as a pose outlier is never triangulated again");
     v("keyframe_min_frames", &keyframe_min_frames, "frames between keyframes at least (frames)");
     v("keyframe_max_frames", &keyframe_max_frames, "a keyframe at least this often (frames)");
     v("keyframe_tracked_ratio", &keyframe_tracked_ratio, "tracked-point share that triggers a keyframe");
@@ -623,6 +629,9 @@ class SlamSystem {
   // epipolar-assisted pose), and the number of such poses in a row.
   std::map<int64_t, std::unordered_map<int64_t, Eigen::Vector2d>> posed_xy_;
   int hybrid_frames_ = 0;
+  // Tracks released as pose outliers (released_tracks_stay_unmapped), with the last image
+  // that observed them: forgotten once they are gone.
+  std::unordered_map<int64_t, int64_t> released_tracks_;
   double hybrid_speed_ = -1.0;  // camera speed (map units per frame) when the run of such poses began
   // The epipolar-assisted pose of `frame` (see SlamOptions::hybrid_tracking); false when
   // no recent image shares enough static tracks or the geometry does not hold.
