@@ -83,13 +83,15 @@ inline Registry& GetRegistry() {
 }  // namespace temp_dir_internal
 
 // A new, empty folder $TMPDIR/mbslam_<tag>_XXXXXX, removed at the normal exit of this
-// process (see the top of the file). "" if it cannot be made (the reason on stderr).
+// process (see the top of the file). Aborts the test (the reason on stderr) when it
+// cannot be made: the callers append file names to it, and "" would have them write to
+// the filesystem's root.
 inline std::string MakeTestTempDir(const std::string& tag) {
   std::string pattern = TestTempRoot() + "/mbslam_" + tag + "_XXXXXX";
   if (::mkdtemp(pattern.data()) == nullptr) {
     std::fprintf(stderr, "MakeTestTempDir: cannot make %s: %s\n", pattern.c_str(),
                  std::strerror(errno));
-    return "";
+    std::abort();
   }
   temp_dir_internal::Registry& registry = temp_dir_internal::GetRegistry();
   std::lock_guard<std::mutex> lock(registry.mutex);

@@ -74,16 +74,18 @@ class ChildProcess {
   ChildProcess& operator=(const ChildProcess&) = delete;
   ~ChildProcess() {
     if (!waited_) Wait(0.0);
-    // Removed here, the one place every ChildProcess passes through (Wait() may run
-    // more than once or, through this destructor, never explicitly).
+    // Removed here, the one place every ChildProcess passes through (Wait() may be
+    // called by the test, or only by this destructor).
     unlink(out_path_.c_str());
     unlink(err_path_.c_str());
   }
 
   void Signal(int signal_number) { kill(pid_, signal_number); }
 
-  // Waits up to timeout_s, then kills it (exit_code -1 then).
+  // Waits up to timeout_s, then kills it (exit_code -1 then). Once the child is reaped,
+  // later calls return the same result (its pid may belong to another process by then).
   ProcessResult Wait(double timeout_s) {
+    if (waited_) return result_;
     ProcessResult result;
     int status = 0;
     bool done = false;
@@ -104,12 +106,14 @@ class ChildProcess {
     waited_ = true;
     result.out = ReadWholeFile(out_path_);
     result.err = ReadWholeFile(err_path_);
+    result_ = result;
     return result;
   }
 
  private:
   pid_t pid_ = -1;
   bool waited_ = false;
+  ProcessResult result_;  // of the first Wait()
   std::string out_path_, err_path_;
 };
 

@@ -445,15 +445,15 @@ TEST(SlamBackfill, ImagesLostWhileTheMapLastsArePosedWhenTrackingComesBack) {
 }
 
 // Track 0 slips at image 20 onto another feature, 0.8 m nearer along a nearby line of
-// sight, and follows it from then on: its point is released as an outlier of the pose.
-// Returns whether track 0 had a point just before the slip, and whether it got one again
-// by image 60.
+// sight, and follows it from then on. `reset_at` >= 0: the SLAM starts a new map there,
+// without track 0 for its first 15 images (so that the new map's keyframes, not its
+// initialisation, would triangulate it).
 struct SlipRun {
-  bool mapped_before = false;
-  bool released = false;
-  bool mapped_again = false;
+  bool mapped_before = false;      // track 0 had a point at image 19
+  bool released_at_slip = false;   // image 20's pose released it, its point kept
+  bool mapped_again = false;       // it got a point again by image 70
 };
-SlipRun RunSlip(bool stay_unmapped) {
+SlipRun RunSlip(bool stay_unmapped, int reset_at = -1) {
   Scene scene(5);
   SlamOptions options;
   options.ba.time_limited = false;
@@ -461,20 +461,30 @@ SlipRun RunSlip(bool stay_unmapped) {
   options.hybrid_tracking = false;
   options.released_tracks_stay_unmapped = stay_unmapped;
   SlamSystem slam(options);
-  const Eigen::Vector3d other = scene.points[0] * (1.0 - 0.8 / scene.points[0].z()) + Eigen::Vector3d(0.05, 0.0, 0.0);
+  const Eigen::Vector3d other =
+      scene.points[0] * (1.0 - 0.8 / scene.points[0].z()) + Eigen::Vector3d(0.05, 0.0, 0.0);
   SlipRun run;
-  for (int f = 0; f < 60; ++f) {
+  int64_t point_before = -1;
+  for (int f = 0; f < 70; ++f) {
+    if (f == reset_at) slam.Reset();
     SlamFrame frame = scene.Frame(f);
-    if (f >= 20) {
+    if (reset_at >= 0 && f >= reset_at && f < reset_at + 15) {
+      frame.observations.erase(frame.observations.begin());
+    } else if (f >= 20) {
       SlamObservation& o = frame.observations[0];
       o.xy = (other - Scene::Center(f)).hnormalized();
       o.uv = o.xy * kFocal + Eigen::Vector2d(320.0, 240.0);
     }
-    if (f == 19) run.mapped_before = slam.map().PointOfTrack(0) >= 0;
+    if (f == 19) {
+      point_before = slam.map().PointOfTrack(0);
+      run.mapped_before = point_before >= 0;
+    }
     slam.TrackPose(frame);
-    if (f >= 20 && slam.map().PointOfTrack(0) < 0) run.released = true;
+    if (f == 20) {
+      run.released_at_slip = slam.map().PointOfTrack(0) < 0 && slam.map().point(point_before) != nullptr;
+    }
     UpdateMapAllStatic(&slam, frame);
-    if (run.released && slam.map().PointOfTrack(0) >= 0) run.mapped_again = true;
+    if (f > 20 && slam.map().PointOfTrack(0) >= 0) run.mapped_again = true;
   }
   return run;
 }
@@ -482,15 +492,21 @@ SlipRun RunSlip(bool stay_unmapped) {
 TEST(SlamReleasedTracks, ATrackThatDriftedOffItsPointIsNotTriangulatedAgain) {
   const SlipRun run = RunSlip(/*stay_unmapped=*/true);
   ASSERT_TRUE(run.mapped_before);
-  ASSERT_TRUE(run.released);
+  ASSERT_TRUE(run.released_at_slip);
   EXPECT_FALSE(run.mapped_again);
 }
 
 TEST(SlamReleasedTracks, WithoutTheOptionItGetsANewPoint) {
   const SlipRun run = RunSlip(/*stay_unmapped=*/false);
   ASSERT_TRUE(run.mapped_before);
-  ASSERT_TRUE(run.released);
+  ASSERT_TRUE(run.released_at_slip);
   EXPECT_TRUE(run.mapped_again);  // the feature it follows now is a consistent static point
+}
+
+TEST(SlamReleasedTracks, ANewMapForgetsThem) {
+  const SlipRun run = RunSlip(/*stay_unmapped=*/true, /*reset_at=*/30);
+  ASSERT_TRUE(run.released_at_slip);
+  EXPECT_TRUE(run.mapped_again);  // the new map triangulates it like any other track
 }
 
 TEST(SlamBackfill, OffKeepsOnlyLivePoses) {

@@ -26,6 +26,10 @@ constexpr double kDeg = M_PI / 180.0;
 // Grid of the initialisation's coverage test (cells across, down).
 constexpr int kInitGridCols = 8;
 constexpr int kInitGridRows = 6;
+// A track released as a pose outlier and unseen by this SLAM for this long is forgotten
+// (frames): it has ended, or left the object's segment long ago. Only bounds the memory:
+// track ids are never reused.
+constexpr int64_t kReleasedTrackMemoryFrames = 300;
 
 // A free essential matrix between normalised correspondences (RANSAC, inlier threshold
 // `thresh` in normalised units), with the correspondences as OpenCV points.
@@ -103,6 +107,7 @@ void SlamSystem::Reset() {
   unposed_.clear();
   posed_xy_.clear();
   hybrid_frames_ = 0;
+  released_tracks_.clear();
 }
 
 void SlamSystem::RestartMap(std::optional<Bridge> bridge) {
@@ -359,6 +364,16 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   SlamPose out;
   if (!options_.enabled) return out;
   frame_utime_[frame.frame_index] = frame.utime;
+  if (!released_tracks_.empty()) {
+    for (const SlamObservation& o : frame.observations) {
+      auto it = released_tracks_.find(o.track_id);
+      if (it != released_tracks_.end()) it->second = frame.frame_index;
+    }
+    for (auto it = released_tracks_.begin(); it != released_tracks_.end();) {
+      const bool ended = frame.frame_index - it->second > kReleasedTrackMemoryFrames;
+      it = ended ? released_tracks_.erase(it) : std::next(it);
+    }
+  }
   while (static_cast<int>(frame_utime_.size()) > options_.backfill_max_frames + 64) frame_utime_.erase(frame_utime_.begin());
   if (state_ == SlamState::kNotInitialized || state_ == SlamState::kInitializing) {
     const bool from_earlier_pair = TryInitialize(frame, &out);
@@ -1292,16 +1307,6 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
   }
   const double max_err = options_.triangulation_max_error_px / frame.focal_px;
   int tracked = 0, unseen = 0, degenerate = 0, low_parallax = 0, reprojection = 0, released = 0;
-  if (!released_tracks_.empty()) {
-    for (const auto& [track, x] : k.track_xy) {
-      auto it = released_tracks_.find(track);
-      if (it != released_tracks_.end()) it->second = frame.frame_index;
-    }
-    // Tracks not seen for a while have ended (track ids are never reused).
-    for (auto it = released_tracks_.begin(); it != released_tracks_.end();) {
-      it = frame.frame_index - it->second > 4 * options_.keyframe_max_frames ? released_tracks_.erase(it) : std::next(it);
-    }
-  }
   for (const auto& [track, x] : k.track_xy) {
     const int64_t pid = map_.PointOfTrack(track);
     if (pid < 0 && released_tracks_.count(track)) {

@@ -124,8 +124,10 @@ struct SlamOptions {
   double triangulation_min_angle_deg = 1.0;  // new points need this parallax (deg)
   double triangulation_max_error_px = 2.0;   // ... and this reprojection error in both views (px)
   // A track released from its point as an outlier of the pose ("drifted off its point")
-  // is never triangulated again while it lives: a feature sliding along an outline keeps
-  // drifting and would make a new wrong point at each keyframe.
+  // is not triangulated again on this map: a feature sliding along an outline keeps
+  // drifting and would make a new wrong point at each keyframe. A new map (restart,
+  // re-initialisation) starts with no such tracks: the map that judged them may have
+  // been the wrong one.
   bool released_tracks_stay_unmapped = false;
   int keyframe_min_frames = 3;           // frames between keyframes at least (frames)
   int keyframe_max_frames = 20;          // a keyframe at least this often while tracking (frames)
@@ -294,7 +296,7 @@ struct SlamOptions {
     v("triangulation_min_angle_deg", &triangulation_min_angle_deg, "parallax of new points (deg)");
     v("triangulation_max_error_px", &triangulation_max_error_px, "reprojection error of new points (px)");
     v("released_tracks_stay_unmapped", &released_tracks_stay_unmapped,
-      "a track released from its point as a pose outlier is never triangulated again");
+      "a track released from its point as a pose outlier is not triangulated again on this map");
     v("keyframe_min_frames", &keyframe_min_frames, "frames between keyframes at least (frames)");
     v("keyframe_max_frames", &keyframe_max_frames, "a keyframe at least this often (frames)");
     v("keyframe_tracked_ratio", &keyframe_tracked_ratio, "tracked-point share that triggers a keyframe");
@@ -629,15 +631,16 @@ class SlamSystem {
   // epipolar-assisted pose), and the number of such poses in a row.
   std::map<int64_t, std::unordered_map<int64_t, Eigen::Vector2d>> posed_xy_;
   int hybrid_frames_ = 0;
-  // Tracks released as pose outliers (released_tracks_stay_unmapped), with the last image
-  // that observed them: forgotten once they are gone.
-  std::unordered_map<int64_t, int64_t> released_tracks_;
   double hybrid_speed_ = -1.0;  // camera speed (map units per frame) when the run of such poses began
   // The epipolar-assisted pose of `frame` (see SlamOptions::hybrid_tracking); false when
   // no recent image shares enough static tracks or the geometry does not hold.
   bool TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eigen::Vector3d>& X,
                          const std::vector<Eigen::Vector2d>& xy, const Rigid3d& prior, PoseEstimate* est);
   int64_t last_frame_ = -1;
+  // Tracks released from their points as pose outliers on this map
+  // (released_tracks_stay_unmapped), with the last image that observed them; forgotten
+  // 300 images after that (slam_system.cc: the track has ended or left; ids are never reused).
+  std::unordered_map<int64_t, int64_t> released_tracks_;
   int lost_frames_ = 0;
   int tracked_points_at_keyframe_ = 0;
   int64_t last_keyframe_frame_ = -1;
