@@ -15,10 +15,6 @@
 namespace mbslam {
 namespace {
 
-std::string TempPath(const std::string& name) {
-  return testing_util::MakeTestTempDir("lcm") + "/" + name;
-}
-
 struct Sample {
   std::string channel;
   std::vector<uint8_t> bytes;
@@ -56,7 +52,7 @@ TEST(LcmBus, EveryTypeRoundTripsThroughMemq) {
 }
 
 TEST(LcmBus, EveryTypeRoundTripsThroughFileLog) {
-  const std::string log = TempPath("roundtrip.lcmlog");
+  const std::string log = testing_util::MakeTestTempPath("lcm", "roundtrip.lcmlog");
   const auto samples = AllSamples(11);
   {
     Status status;

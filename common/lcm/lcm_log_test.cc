@@ -10,10 +10,6 @@
 namespace mbslam {
 namespace {
 
-std::string TempPath(const std::string& name) {
-  return testing_util::MakeTestTempDir("log") + "/" + name;
-}
-
 void WriteLog(const std::string& path) {
   Status status;
   auto writer = LcmLogWriter::Open(path, &status);
@@ -30,8 +26,8 @@ void WriteLog(const std::string& path) {
 }
 
 TEST(LcmLog, WriterStampsMessageTimeSoLogsAreByteIdentical) {
-  const std::string a = TempPath("a.lcmlog");
-  const std::string b = TempPath("b.lcmlog");
+  const std::string a = testing_util::MakeTestTempPath("log", "a.lcmlog");
+  const std::string b = testing_util::MakeTestTempPath("log", "b.lcmlog");
   WriteLog(a);
   usleep(2000);
   WriteLog(b);

@@ -99,6 +99,11 @@ inline std::string MakeTestTempDir(const std::string& tag) {
   return pattern;
 }
 
+// The path of `name` in a new such folder.
+inline std::string MakeTestTempPath(const std::string& tag, const std::string& name) {
+  return MakeTestTempDir(tag) + "/" + name;
+}
+
 }  // namespace testing_util
 }  // namespace mbslam
 

@@ -110,7 +110,7 @@ TEST(DriverRestart, ServiceSurvivesAKilledAndRestartedCameraDriver) {
   std::string error;
   const std::string seq = fault_test::EnsureSequence(&error);
   ASSERT_FALSE(seq.empty()) << error;
-  const std::string work = fault_test::MakeTempDir("driver_restart");
+  const std::string work = testing_util::MakeTestTempDir("driver_restart");
   ASSERT_FALSE(work.empty());
 
   Status s;

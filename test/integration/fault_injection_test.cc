@@ -89,7 +89,7 @@ class FaultInjection : public ::testing::Test {
   // event published at its log time / speed (wall clock), the service dropping stale frames.
   static ServiceRun Run(const LogEditor& log, bool realtime = false, double speed = 1.0) {
     ServiceRun run;
-    const std::string work = fault_test::MakeTempDir("fault_run");
+    const std::string work = testing_util::MakeTestTempDir("fault_run");
     PerceptionOptions options;
     options.pipeline.mode = realtime ? "realtime" : "lockstep";
     options.service.output_log = work + "/out.lcmlog";

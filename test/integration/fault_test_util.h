@@ -57,11 +57,6 @@ inline std::string EnsureSequence(std::string* error) {
   return dir;
 }
 
-// A new folder mbslam_<tag>_XXXXXX, removed when the test process exits.
-inline std::string MakeTempDir(const std::string& tag) {
-  return testing_util::MakeTestTempDir(tag);
-}
-
 // Every event of an output log decodes as the type of its channel.
 struct OutputLogCheck {
   int events = 0;

@@ -117,14 +117,15 @@ struct ObjectReconstructionOptions {
   // 16 of 19 (its map 0.98 -> 14.7 % trajectory); as it is, two sim-multi maps drop it,
   // and the unit scene's walker turning 60 deg/s drops it after about 50 deg.
   double rotation_prior_keep_inlier_ratio = 0.9;
-  // A track released from its point as an outlier of the object's pose is never
-  // triangulated again (SlamOptions::released_tracks_stay_unmapped): a feature on the
+  // A track released from its point as an outlier of the object's pose is not
+  // triangulated again on that map (SlamOptions::released_tracks_stay_unmapped): a feature on the
   // object's outline (half the object, half what is behind it) slides along it, and was
   // made a new wrong point at each keyframe. Lockstep, longest map, trajectory / shape
   // (% of path / size), seeds 1 / 2 / 3: sim-crossing 0.98 / 4.0, 1.05 / 14.2, 29 / 715 ->
-  // 0.89 / 2.9, 0.97 / 9.9, 6.5 / 743 (seed 3 reconstructs the robot instead of a
-  // walker-and-car mix); sim-multi seed 1 8.1 / 42 -> 8.4 / 28, seeds 2 / 3 and
-  // sim-following / sim-previously_static within +-0.2 points. For the world's map (the
+  // 0.89 / 2.9, 0.97 / 9.9, 6.5 / 743 (seed 3's longest map is still of a segment that
+  // mixes the walker, the car behind him, the robot and static features); sim-multi
+  // seed 1 8.1 / 42 -> 8.4 / 28, seeds 2 / 3 and
+  // sim-following / sim-previously_static within +-0.4 points. For the world's map (the
   // SLAM option) it was worse: TartanAir five starts ATE 0.83 -> 1.88 %.
   bool released_tracks_stay_unmapped = true;
 
@@ -186,7 +187,7 @@ struct ObjectReconstructionOptions {
     v("rotation_prior_keep_inlier_ratio", &rotation_prior_keep_inlier_ratio,
       "... and keeps it while the known rotation explains this share of a free E's inliers at each keyframe (0 = always)");
     v("released_tracks_stay_unmapped", &released_tracks_stay_unmapped,
-      "object SLAM: a track released from its point as a pose outlier is never triangulated again");
+      "object SLAM: a track released from its point as a pose outlier is not triangulated again on that map");
   }
 };
 
