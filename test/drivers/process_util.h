@@ -10,6 +10,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -73,7 +74,7 @@ class ChildProcess {
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
   ~ChildProcess() {
-    if (!waited_) Wait(0.0);
+    if (!result_) Wait(0.0);
     // Removed here, the one place every ChildProcess passes through (Wait() may be
     // called by the test, or only by this destructor).
     unlink(out_path_.c_str());
@@ -85,7 +86,7 @@ class ChildProcess {
   // Waits up to timeout_s, then kills it (exit_code -1 then). Once the child is reaped,
   // later calls return the same result (its pid may belong to another process by then).
   ProcessResult Wait(double timeout_s) {
-    if (waited_) return result_;
+    if (result_) return *result_;
     ProcessResult result;
     int status = 0;
     bool done = false;
@@ -103,7 +104,6 @@ class ChildProcess {
     } else if (WIFEXITED(status)) {
       result.exit_code = WEXITSTATUS(status);
     }
-    waited_ = true;
     result.out = ReadWholeFile(out_path_);
     result.err = ReadWholeFile(err_path_);
     result_ = result;
@@ -112,8 +112,7 @@ class ChildProcess {
 
  private:
   pid_t pid_ = -1;
-  bool waited_ = false;
-  ProcessResult result_;  // of the first Wait()
+  std::optional<ProcessResult> result_;  // of the first Wait(): the child is reaped
   std::string out_path_, err_path_;
 };
 

@@ -639,7 +639,7 @@ class SlamSystem {
   int64_t last_frame_ = -1;
   // Tracks released from their points as pose outliers on this map
   // (released_tracks_stay_unmapped), with the last image that observed them; forgotten
-  // 300 images after that (slam_system.cc: the track has ended or left; ids are never reused).
+  // kReleasedTrackMemoryFrames after that (slam_system.cc).
   std::unordered_map<int64_t, int64_t> released_tracks_;
   int lost_frames_ = 0;
   int tracked_points_at_keyframe_ = 0;
