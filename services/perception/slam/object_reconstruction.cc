@@ -178,6 +178,45 @@ std::vector<size_t> AxisCompactIndices(const std::vector<Eigen::Vector3d>& in, d
   return kept;
 }
 
+std::vector<size_t> DenseIndices(const std::vector<Eigen::Vector3d>& points, int neighbours, double max_mads) {
+  const size_t n = points.size();
+  const size_t k = static_cast<size_t>(std::max(neighbours, 1));
+  if (max_mads <= 0.0 || n < 8 || n <= 2 * k) return AllIndices(n);
+  // Each point's mean distance to its k nearest others.
+  std::vector<double> isolation(n);
+  std::vector<double> d;
+  d.reserve(n - 1);
+  for (size_t i = 0; i < n; ++i) {
+    d.clear();
+    for (size_t j = 0; j < n; ++j) {
+      if (j != i) d.push_back((points[i] - points[j]).norm());
+    }
+    std::partial_sort(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
+    isolation[i] = std::accumulate(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), 0.0) / static_cast<double>(k);
+  }
+  const double median = Median(isolation);
+  std::vector<double> dev;
+  dev.reserve(n);
+  for (double x : isolation) dev.push_back(std::abs(x - median));
+  // 1.4826 MAD: the standard deviation of a normal distribution; floored at a fifth of
+  // the median, as points sampled evenly (a lattice) have next to no deviation and the
+  // slightly more isolated ones on its edges would go.
+  const double sigma = std::max(1.4826 * Median(dev), 0.2 * median);
+  // Half the points or more at one place: no scale to measure by.
+  if (!(sigma > 0.0)) return AllIndices(n);
+  std::vector<size_t> kept;
+  kept.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    if (isolation[i] <= median + max_mads * sigma) kept.push_back(i);  // NaN: left out
+  }
+  return kept;
+}
+
+std::vector<Eigen::Vector3d> DensePoints(const std::vector<Eigen::Vector3d>& points, int neighbours,
+                                         double max_mads) {
+  return Select(points, DenseIndices(points, neighbours, max_mads));
+}
+
 std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d>& in, double max_mads,
                                                double min_mad_share) {
   return Select(in, AxisCompactIndices(in, max_mads, min_mad_share));
@@ -196,6 +235,7 @@ std::vector<int64_t> BodyPointIds(const Map& map, const ObjectReconstructionOpti
   apply(CompactIndices(points, options.max_point_spread));
   apply(LargestClusterIndices(points, options.cluster_link_factor));
   apply(AxisCompactIndices(points, options.max_axis_mads, options.min_axis_mad_share));
+  apply(DenseIndices(points, options.isolation_neighbours, options.max_isolation_mads));
   return ids;
 }
 
