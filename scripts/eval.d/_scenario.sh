@@ -76,6 +76,8 @@ out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float
        "tracked_fraction": ate.get("fraction_tracked"), "tracked_fraction_live": summary.get("tracked_fraction"),
        "sim3_scale": ate.get("scale"),
        "moving_recall": seg.get("moving_recall"), "moving_precision": seg.get("moving_precision"),
+       "moving_recall_off_silhouette": seg.get("moving_recall_off_silhouette"),
+       "moving_precision_off_silhouette": seg.get("moving_precision_off_silhouette"),
        "false_moving_fraction": seg.get("false_moving_fraction"),
        "track_misclassification": seg.get("misclassification"),
        "detection_delay_frames": seg.get("detection_delay_frames"),
@@ -120,7 +122,8 @@ if ate_nf:
 def pct(v):
     return "n/a" if v is None else f"{100*v:.3f} %"
 print(f"sim-{name}: ATE {pct(out['ate_rel_path'])} of {length:.2f} m (live poses {pct(out['ate_rel_path_live'])}), tracked {pct(out['tracked_fraction'])} (live {pct(out['tracked_fraction_live'])}), "
-      f"moving recall {out['moving_recall']}, precision {out['moving_precision']}, false moving {out['false_moving_fraction']}")
+      f"moving recall {out['moving_recall']}, precision {out['moving_precision']} ({out['moving_recall_off_silhouette']} / "
+      f"{out['moving_precision_off_silhouette']} 3 px or more off the movers' silhouettes), false moving {out['false_moving_fraction']}")
 if obj:
     print(f"  objects: {obj.get('est_objects')} estimated, {obj.get('matched')} matched of {obj.get('gt_bodies')}; "
           f"error/range from 2 s {out['object_pos_err_rel_2s']}, relative scale error {out['relative_scale_error']}, "

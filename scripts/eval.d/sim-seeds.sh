@@ -34,7 +34,8 @@ for name in $scenarios; do
 done
 python3 - "${results[@]}" <<'PY'
 import json, sys
-keys = ["ate_rel_path", "tracked_fraction", "tracked_fraction_live", "scale_error", "moving_recall", "moving_precision", "object_pos_err_rel_2s",
+keys = ["ate_rel_path", "tracked_fraction", "tracked_fraction_live", "scale_error", "moving_recall", "moving_precision",
+        "moving_recall_off_silhouette", "moving_precision_off_silhouette", "object_pos_err_rel_2s",
         "relative_scale_error", "predicted_hit_rate_0_5s", "predicted_hit_rate_1s",
         "predicted_hit_rate_0_5s_all_estimates", "predicted_hit_rate_1s_all_estimates",
         "predicted_overlap_rate_1s_all_estimates",

@@ -9,7 +9,9 @@
 // object counts as static until it starts). Frames from `settle` frames after each
 // mover's appearance are scored. Prints a summary and, last, one JSON line:
 //   moving_recall, moving_precision, detection_delay_frames (per object), misclassification
-//   (track level, Hungarian), frames_scored.
+//   (track level, Hungarian), frames_scored; and moving_recall_off_silhouette /
+//   moving_precision_off_silhouette: the same without the features closer than
+//   --silhouette-px (3) to the boundary between moving and not moving pixels.
 // Env EVAL_DUMP_TP / EVAL_DUMP_FP / EVAL_DUMP_FN / EVAL_DUMP_TN set (to any value) print each scored
 // feature of that outcome first ("TP frame F id T uv U V body B mask M p P epi E fvb F
 // age A"; FP lines add the distance to the nearest moving pixel).
@@ -40,8 +42,9 @@ int Run(int argc, char** argv) {
   const CommandLineArgs args(argc, argv);
   const std::string run = args.Get("run"), seq = args.Get("sequence"), name = args.Get("name", "sequence");
   const int settle = static_cast<int>(args.GetInt("settle", 10));
+  const double silhouette_px = args.GetDouble("silhouette-px", 3.0);
   if (const std::string problems = args.Problems(); !problems.empty()) {
-    std::fprintf(stderr, "mbslam-eval-segmentation: %s\nusage: mbslam-eval-segmentation --run OUT.lcmlog --sequence SIM_DIR [--settle N] [--name NAME]\n",
+    std::fprintf(stderr, "mbslam-eval-segmentation: %s\nusage: mbslam-eval-segmentation --run OUT.lcmlog --sequence SIM_DIR [--settle N] [--silhouette-px D] [--name NAME]\n",
                  problems.c_str());
     return 2;
   }
@@ -82,6 +85,10 @@ int Run(int argc, char** argv) {
     return 1;
   }
   int64_t tp = 0, fp = 0, fn = 0, tn = 0, frames = 0;
+  // The same away from the movers' silhouettes: features closer than silhouette_px to the
+  // boundary between moving and not moving pixels are left out (a corner on the
+  // outline, whose patch covers both sides, moves with the outline).
+  int64_t tp_off = 0, fp_off = 0, fn_off = 0;
   std::map<int, int64_t> detected_frame;  // true body -> first frame its features were mostly moving with an object
   std::map<int64_t, std::map<int, int>> truth_votes, pred_votes;  // track -> body -> count
   for (const LcmLogEvent& e : events) {
@@ -100,8 +107,12 @@ int Run(int argc, char** argv) {
         if (b != 0 && movers.count(b)) not_moving.at<uint8_t>(y, x) = 0;
       }
     }
-    cv::Mat dist;
+    cv::Mat dist, dist_in;
     cv::distanceTransform(not_moving, dist, cv::DIST_L2, 3);
+    // ... and of every moving pixel to the nearest pixel that is not.
+    cv::Mat moving_px;
+    cv::bitwise_not(not_moving, moving_px);
+    cv::distanceTransform(moving_px, dist_in, cv::DIST_L2, 3);
     std::map<int, std::pair<int, int>> per_body;  // body -> (features, labelled moving with an object)
     bool scored = false;
     for (const auto& f : t.tracks) {
@@ -149,6 +160,12 @@ int Run(int argc, char** argv) {
       }
       fn += truly_moving && !labelled_moving;
       tn += !truly_moving && !labelled_moving;
+      const float to_silhouette = truly_moving ? dist_in.at<float>(v, u) : dist.at<float>(v, u);
+      if (to_silhouette >= silhouette_px) {
+        tp_off += truly_moving && labelled_moving;
+        fp_off += !truly_moving && labelled_moving;
+        fn_off += truly_moving && !labelled_moving;
+      }
     }
     frames += scored;
     for (const auto& [body, counts] : per_body) {
@@ -173,10 +190,15 @@ int Run(int argc, char** argv) {
   }
   const double recall = tp + fn > 0 ? static_cast<double>(tp) / (tp + fn) : 1.0;
   const double precision = tp + fp > 0 ? static_cast<double>(tp) / (tp + fp) : 1.0;
+  const double recall_off = tp_off + fn_off > 0 ? static_cast<double>(tp_off) / (tp_off + fn_off) : 1.0;
+  const double precision_off = tp_off + fp_off > 0 ? static_cast<double>(tp_off) / (tp_off + fp_off) : 1.0;
   const double miscl = Misclassification(truth, pred);
   std::printf("%s: frames scored %lld, moving features: recall %.3f precision %.3f (tp %lld fp %lld fn %lld)\n",
               name.c_str(), static_cast<long long>(frames), recall, precision,
               static_cast<long long>(tp), static_cast<long long>(fp), static_cast<long long>(fn));
+  std::printf("  %.0f px or more from a mover's silhouette: recall %.3f precision %.3f (tp %lld fp %lld fn %lld)\n",
+              silhouette_px, recall_off, precision_off, static_cast<long long>(tp_off),
+              static_cast<long long>(fp_off), static_cast<long long>(fn_off));
   std::printf("track-level misclassification %.2f%% over %zu tracks\n", 100.0 * miscl, truth.size());
   std::string delays;
   double delay_sum = 0.0;
@@ -193,10 +215,12 @@ int Run(int argc, char** argv) {
     }
   }
   const double false_moving = fp + tn > 0 ? static_cast<double>(fp) / static_cast<double>(fp + tn) : 0.0;
-  std::printf("{\"name\": \"%s\", \"moving_recall\": %.4f, \"moving_precision\": %.4f, \"misclassification\": %.4f, "
+  std::printf("{\"name\": \"%s\", \"moving_recall\": %.4f, \"moving_precision\": %.4f, "
+              "\"moving_recall_off_silhouette\": %.4f, \"moving_precision_off_silhouette\": %.4f, \"silhouette_px\": %.1f, "
+              "\"misclassification\": %.4f, "
               "\"false_moving_fraction\": %.5f, \"frames_scored\": %lld, \"objects\": %zu, \"objects_detected\": %d, \"mean_detection_delay_frames\": %.2f, "
               "\"detection_delay_frames\": {%s}}\n",
-              name.c_str(), recall, precision, miscl, false_moving, static_cast<long long>(frames), first_moving_frame.size(),
+              name.c_str(), recall, precision, recall_off, precision_off, silhouette_px, miscl, false_moving, static_cast<long long>(frames), first_moving_frame.size(),
               delay_n, delay_n ? delay_sum / delay_n : -1.0, delays.c_str());
   return 0;
 }
