@@ -4,7 +4,9 @@
 // Small robust statistics shared by the algorithm layers.
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace mbslam {
@@ -16,6 +18,16 @@ inline double Median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
   return v[mid];
 }
+
+// The median absolute deviation of v about `centre`. kMadToSigma times it is the
+// standard deviation of a normal distribution.
+inline double MedianAbsoluteDeviation(const std::vector<double>& v, double centre) {
+  std::vector<double> dev;
+  dev.reserve(v.size());
+  for (double x : v) dev.push_back(std::abs(x - centre));
+  return Median(std::move(dev));
+}
+constexpr double kMadToSigma = 1.4826;
 
 }  // namespace mbslam
 

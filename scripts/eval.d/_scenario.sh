@@ -78,6 +78,7 @@ out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float
        "moving_recall": seg.get("moving_recall"), "moving_precision": seg.get("moving_precision"),
        "moving_recall_off_silhouette": seg.get("moving_recall_off_silhouette"),
        "moving_precision_off_silhouette": seg.get("moving_precision_off_silhouette"),
+       "silhouette_px": seg.get("silhouette_px"),
        "false_moving_fraction": seg.get("false_moving_fraction"),
        "track_misclassification": seg.get("misclassification"),
        "detection_delay_frames": seg.get("detection_delay_frames"),
@@ -123,7 +124,7 @@ def pct(v):
     return "n/a" if v is None else f"{100*v:.3f} %"
 print(f"sim-{name}: ATE {pct(out['ate_rel_path'])} of {length:.2f} m (live poses {pct(out['ate_rel_path_live'])}), tracked {pct(out['tracked_fraction'])} (live {pct(out['tracked_fraction_live'])}), "
       f"moving recall {out['moving_recall']}, precision {out['moving_precision']} ({out['moving_recall_off_silhouette']} / "
-      f"{out['moving_precision_off_silhouette']} 3 px or more off the movers' silhouettes), false moving {out['false_moving_fraction']}")
+      f"{out['moving_precision_off_silhouette']} {out['silhouette_px']} px or more off the movers' silhouettes), false moving {out['false_moving_fraction']}")
 if obj:
     print(f"  objects: {obj.get('est_objects')} estimated, {obj.get('matched')} matched of {obj.get('gt_bodies')}; "
           f"error/range from 2 s {out['object_pos_err_rel_2s']}, relative scale error {out['relative_scale_error']}, "

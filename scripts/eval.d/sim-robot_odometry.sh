@@ -29,6 +29,7 @@ out = {"scenario": "robot_odometry", "path_length_m": length,
        "moving_recall": seg.get("moving_recall"), "moving_precision": seg.get("moving_precision"),
        "moving_recall_off_silhouette": seg.get("moving_recall_off_silhouette"),
        "moving_precision_off_silhouette": seg.get("moving_precision_off_silhouette"),
+       "silhouette_px": seg.get("silhouette_px"),
        "false_moving_fraction": seg.get("false_moving_fraction")}
 print(f"sim-robot_odometry: metric scale error {100*out['scale_error']:.2f} %, ATE (Sim3) {100*out['ate_rel_path']:.3f} % of {length:.2f} m, "
       f"ATE (SE3, metric) {se3['ate_rmse_m']:.4f} m, tracked {100*out['tracked_fraction']:.1f} % (live {100*out['tracked_fraction_live']:.1f} %); moving recall "

@@ -17,6 +17,7 @@
 #include "mbslam/ground_truth_t.hpp"
 #include "mbslam/tracks_t.hpp"
 #include "tools/eval/json.h"
+#include "test/tools/feature_tracks.h"
 #include "test/tools/run_command.h"
 
 namespace mbslam {
@@ -32,15 +33,7 @@ double Get(const Json& j, const std::string& key) {
   return v ? v->AsDouble() : NAN;
 }
 
-mbslam::feature_track_t Feature(int64_t id, float u, float v, int body) {
-  mbslam::feature_track_t t{};
-  t.id = id;
-  t.u = u;
-  t.v = v;
-  t.age = 3;
-  t.body_id = body;
-  return t;
-}
+using testing_util::FeatureTrack;
 
 // A 64x48 image whose body 1, the square [20, 40) x [10, 30), moves.
 void WriteSequence(const fs::path& dir) {
@@ -84,12 +77,12 @@ TEST(EvalSegmentationCli, RecallAndPrecisionWithAndWithoutTheSilhouette) {
   if (!fs::exists(Bin())) GTEST_SKIP() << Bin() << " not built";
   const fs::path dir = testing_util::MakeTestTempDir("eval_segmentation_cli");
   ASSERT_NO_FATAL_FAILURE(WriteSequence(dir / "seq"));
-  // On the mover: deep inside and labelled moving (TP), on its edge and labelled moving
-  // (TP, 1 px inside), inside and labelled static (FN). Off it: 2 px left of its edge
-  // labelled moving (FP), far and labelled moving (FP), far and static (TN).
-  ASSERT_NO_FATAL_FAILURE(WriteRun(dir / "run.lcmlog", {Feature(1, 30, 20, 1), Feature(2, 20, 20, 1),
-                                                         Feature(3, 35, 25, 0), Feature(4, 18, 20, 1),
-                                                         Feature(5, 5, 5, 1), Feature(6, 55, 40, 0)}));
+  // On the mover: deep inside and labelled moving (TP), on its edge pixel and labelled
+  // moving (TP), inside and labelled static (FN). Off it: 2 px left of its edge labelled
+  // moving (FP), 3 px left of it labelled moving (FP), far and static (TN).
+  ASSERT_NO_FATAL_FAILURE(WriteRun(dir / "run.lcmlog", {FeatureTrack(1, 30, 20, 1), FeatureTrack(2, 20, 20, 1),
+                                                         FeatureTrack(3, 35, 25, 0), FeatureTrack(4, 18, 20, 1),
+                                                         FeatureTrack(5, 17, 15, 1), FeatureTrack(6, 55, 40, 0)}));
   std::string out;
   const std::string args = " --run " + (dir / "run.lcmlog").string() + " --sequence " + (dir / "seq").string() +
                            " --settle 0";
@@ -98,7 +91,7 @@ TEST(EvalSegmentationCli, RecallAndPrecisionWithAndWithoutTheSilhouette) {
   ASSERT_TRUE(Json::Parse(testing_util::LastLine(out), &j)) << out;
   EXPECT_NEAR(Get(j, "moving_recall"), 2.0 / 3.0, 1e-3);
   EXPECT_NEAR(Get(j, "moving_precision"), 0.5, 1e-3);
-  // 3 px or more from the silhouette: features 1, 3 (5 px in) and 5 are scored.
+  // 3 px or more from the silhouette: features 1, 3 (5 px in) and 5 (3 px out) are scored.
   EXPECT_NEAR(Get(j, "silhouette_px"), 3.0, 1e-9);
   EXPECT_NEAR(Get(j, "moving_recall_off_silhouette"), 0.5, 1e-3);
   EXPECT_NEAR(Get(j, "moving_precision_off_silhouette"), 0.5, 1e-3);

@@ -48,6 +48,10 @@ int Run(int argc, char** argv) {
                  problems.c_str());
     return 2;
   }
+  if (!(silhouette_px >= 0.0)) {
+    std::fprintf(stderr, "mbslam-eval-segmentation: --silhouette-px must be >= 0\n");
+    return 2;
+  }
   if (run.empty() || seq.empty()) {
     std::fprintf(stderr, "mbslam-eval-segmentation: --run and --sequence are required\n");
     return 2;
@@ -108,11 +112,11 @@ int Run(int argc, char** argv) {
       }
     }
     cv::Mat dist, dist_in;
-    cv::distanceTransform(not_moving, dist, cv::DIST_L2, 3);
+    cv::distanceTransform(not_moving, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
     // ... and of every moving pixel to the nearest pixel that is not.
     cv::Mat moving_px;
     cv::bitwise_not(not_moving, moving_px);
-    cv::distanceTransform(moving_px, dist_in, cv::DIST_L2, 3);
+    cv::distanceTransform(moving_px, dist_in, cv::DIST_L2, cv::DIST_MASK_PRECISE);
     std::map<int, std::pair<int, int>> per_body;  // body -> (features, labelled moving with an object)
     bool scored = false;
     for (const auto& f : t.tracks) {
@@ -196,7 +200,7 @@ int Run(int argc, char** argv) {
   std::printf("%s: frames scored %lld, moving features: recall %.3f precision %.3f (tp %lld fp %lld fn %lld)\n",
               name.c_str(), static_cast<long long>(frames), recall, precision,
               static_cast<long long>(tp), static_cast<long long>(fp), static_cast<long long>(fn));
-  std::printf("  %.0f px or more from a mover's silhouette: recall %.3f precision %.3f (tp %lld fp %lld fn %lld)\n",
+  std::printf("  %.1f px or more from a mover's silhouette: recall %.3f precision %.3f (tp %lld fp %lld fn %lld)\n",
               silhouette_px, recall_off, precision_off, static_cast<long long>(tp_off),
               static_cast<long long>(fp_off), static_cast<long long>(fn_off));
   std::printf("track-level misclassification %.2f%% over %zu tracks\n", 100.0 * miscl, truth.size());

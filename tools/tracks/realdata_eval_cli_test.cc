@@ -24,6 +24,7 @@
 #include "tools/eval/datasets.h"
 #include "tools/eval/json.h"
 #include "tools/tracks/realdata_scoring.h"
+#include "test/tools/feature_tracks.h"
 #include "test/tools/run_command.h"
 
 namespace mbslam {
@@ -61,15 +62,7 @@ class RealDataCli : public ::testing::Test {
   fs::path dir_;
 };
 
-mbslam::feature_track_t Track(int64_t id, float u, float v, int body) {
-  mbslam::feature_track_t t{};
-  t.id = id;
-  t.u = u;
-  t.v = v;
-  t.age = 3;
-  t.body_id = body;
-  return t;
-}
+using testing_util::FeatureTrack;
 
 void WriteTracks(LcmLogWriter* w, int64_t seq, int width, int height,
                  const std::vector<mbslam::feature_track_t>& tracks,
@@ -125,9 +118,9 @@ TEST_F(RealDataCli, DavisKnownAnswers) {
     // aa: frame 0 P 1 R 1/2 J 1 (hull = mask); frame 1 P 1/2, R 1, J 0.25 (quarter hull).
     auto w = LcmLogWriter::Open((dir_ / "runs/aa/out.lcmlog").string(), &st);
     ASSERT_TRUE(w);
-    WriteTracks(w.get(), 0, 100, 100, {Track(1, 30, 30, 1), Track(2, 40, 40, 0), Track(3, 5, 5, 0)},
+    WriteTracks(w.get(), 0, 100, 100, {FeatureTrack(1, 30, 30, 1), FeatureTrack(2, 40, 40, 0), FeatureTrack(3, 5, 5, 0)},
                 {{{20, 20}, {59, 20}, {59, 59}, {20, 59}}});
-    WriteTracks(w.get(), 1, 100, 100, {Track(1, 30, 30, 1), Track(4, 80, 80, 1)},
+    WriteTracks(w.get(), 1, 100, 100, {FeatureTrack(1, 30, 30, 1), FeatureTrack(4, 80, 80, 1)},
                 {{{20, 20}, {39, 20}, {39, 39}, {20, 39}}});
     w->Flush();
   }
@@ -135,7 +128,7 @@ TEST_F(RealDataCli, DavisKnownAnswers) {
     // bb: frame 0 nothing moving (P undefined, R 0, J 0); frame 1 no output at all.
     auto w = LcmLogWriter::Open((dir_ / "runs/bb/out.lcmlog").string(), &st);
     ASSERT_TRUE(w);
-    WriteTracks(w.get(), 0, 100, 100, {Track(1, 30, 30, 0), Track(2, 90, 90, 0)}, {});
+    WriteTracks(w.get(), 0, 100, 100, {FeatureTrack(1, 30, 30, 0), FeatureTrack(2, 90, 90, 0)}, {});
     w->Flush();
   }
   Json j;
@@ -178,10 +171,10 @@ TEST_F(RealDataCli, CamVidKnownAnswers) {
   ASSERT_TRUE(w);
   // Moving: 1 on building, 3 on car; static: 1 on car, 5 on building.
   WriteTracks(w.get(), 0, 80, 60,
-              {Track(1, 10, 10, 1), Track(2, 50, 10, 1), Track(3, 50, 20, 1), Track(4, 50, 30, 0),
-               Track(5, 10, 20, 0), Track(6, 10, 30, 0)},
+              {FeatureTrack(1, 10, 10, 1), FeatureTrack(2, 50, 10, 1), FeatureTrack(3, 50, 20, 1), FeatureTrack(4, 50, 30, 0),
+               FeatureTrack(5, 10, 20, 0), FeatureTrack(6, 10, 30, 0)},
               {});
-  WriteTracks(w.get(), 1, 80, 60, {Track(2, 60, 10, 2), Track(5, 10, 20, 0), Track(6, 10, 30, 0), Track(7, 10, 40, 0)}, {});
+  WriteTracks(w.get(), 1, 80, 60, {FeatureTrack(2, 60, 10, 2), FeatureTrack(5, 10, 20, 0), FeatureTrack(6, 10, 30, 0), FeatureTrack(7, 10, 40, 0)}, {});
   w->Flush();
   Json j;
   ASSERT_EQ(RunCli("camvid --root " + (dir_ / "camvid").string() + " --run " + (dir_ / "out.lcmlog").string(), &j), 0);

@@ -16,6 +16,7 @@
 #include "common/lcm/lcm_log.h"
 #include "mbslam/objects_t.hpp"
 #include "mbslam/tracks_t.hpp"
+#include "test/tools/feature_tracks.h"
 
 namespace mbslam {
 namespace eval {
@@ -290,18 +291,7 @@ class TempDir {
   fs::path path_;
 };
 
-mbslam::feature_track_t Track(int64_t id, float u, float v, int body, int8_t flags = 0) {
-  mbslam::feature_track_t t{};
-  t.id = id;
-  t.u = u;
-  t.v = v;
-  t.prev_u = u;
-  t.prev_v = v;
-  t.age = 5;
-  t.body_id = body;
-  t.flags = flags;
-  return t;
-}
+using testing_util::FeatureTrack;
 
 mbslam::image_hull_t Hull(int body, float x0, float y0, float x1, float y1) {
   mbslam::image_hull_t h{};
@@ -335,9 +325,9 @@ TEST(RealDataScoring, LogToDavisSequenceScore) {
     t.frame_seq = 0;
     t.width = 100;
     t.height = 100;
-    t.tracks = {Track(1, 30, 30, 1), Track(2, 40, 40, 1), Track(3, 50, 50, 0), Track(4, 80, 80, 1),
-                Track(5, 10, 10, 0), Track(6, 45, 45, 0, FT::FLAG_NEW), Track(7, 35, 35, 0, FT::FLAG_OCCLUDED),
-                Track(8, 90, 90, -1)};
+    t.tracks = {FeatureTrack(1, 30, 30, 1), FeatureTrack(2, 40, 40, 1), FeatureTrack(3, 50, 50, 0), FeatureTrack(4, 80, 80, 1),
+                FeatureTrack(5, 10, 10, 0), FeatureTrack(6, 45, 45, 0, 3, FT::FLAG_NEW), FeatureTrack(7, 35, 35, 0, 3, FT::FLAG_OCCLUDED),
+                FeatureTrack(8, 90, 90, -1)};
     t.num_tracks = static_cast<int32_t>(t.tracks.size());
     t.hulls = {Hull(1, 30, 30, 80, 80)};
     t.num_hulls = 1;
@@ -354,7 +344,7 @@ TEST(RealDataScoring, LogToDavisSequenceScore) {
     ASSERT_TRUE(w->Write(ch.perception_objects, 1000, o).ok());
     t.utime = 2000;
     t.frame_seq = 1;
-    t.tracks = {Track(1, 30, 30, 1), Track(2, 40, 40, 0)};
+    t.tracks = {FeatureTrack(1, 30, 30, 1), FeatureTrack(2, 40, 40, 0)};
     t.num_tracks = 2;
     t.hulls = {Hull(1, 20, 20, 39, 59)};
     ASSERT_TRUE(w->Write(ch.perception_tracks, 2000, t).ok());

@@ -153,11 +153,10 @@ std::vector<size_t> AxisCompactIndices(const std::vector<Eigen::Vector3d>& in, d
   const Eigen::Matrix3d axes = eig.eigenvectors();  // columns
   Eigen::Vector3d med, mad;
   for (int a = 0; a < 3; ++a) {
-    std::vector<double> proj, dev;
+    std::vector<double> proj;
     for (const Eigen::Vector3d& p : points) proj.push_back(axes.col(a).dot(p - centre));
     med[a] = Median(proj);
-    for (double x : proj) dev.push_back(std::abs(x - med[a]));
-    mad[a] = Median(dev);
+    mad[a] = MedianAbsoluteDeviation(proj, med[a]);
   }
   // Half the points or more at one place: no spread to measure by.
   if (!(mad.maxCoeff() > 0.0)) return finite;
@@ -178,10 +177,17 @@ std::vector<size_t> AxisCompactIndices(const std::vector<Eigen::Vector3d>& in, d
   return kept;
 }
 
-std::vector<size_t> DenseIndices(const std::vector<Eigen::Vector3d>& points, int neighbours, double max_mads) {
-  const size_t n = points.size();
+std::vector<size_t> DenseIndices(const std::vector<Eigen::Vector3d>& in, int neighbours, double max_mads) {
   const size_t k = static_cast<size_t>(std::max(neighbours, 1));
-  if (max_mads <= 0.0 || n < 8 || n <= 2 * k) return AllIndices(n);
+  if (max_mads <= 0.0 || in.size() < 8 || in.size() <= 2 * k) return AllIndices(in.size());
+  std::vector<size_t> finite;  // a non-finite point is never published
+  finite.reserve(in.size());
+  for (size_t i = 0; i < in.size(); ++i) {
+    if (in[i].allFinite()) finite.push_back(i);
+  }
+  const std::vector<Eigen::Vector3d> points = Select(in, finite);
+  const size_t n = points.size();
+  if (n < 8 || n <= 2 * k) return finite;
   // Each point's mean distance to its k nearest others.
   std::vector<double> isolation(n);
   std::vector<double> d;
@@ -195,19 +201,16 @@ std::vector<size_t> DenseIndices(const std::vector<Eigen::Vector3d>& points, int
     isolation[i] = std::accumulate(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), 0.0) / static_cast<double>(k);
   }
   const double median = Median(isolation);
-  std::vector<double> dev;
-  dev.reserve(n);
-  for (double x : isolation) dev.push_back(std::abs(x - median));
-  // 1.4826 MAD: the standard deviation of a normal distribution; floored at a fifth of
-  // the median, as points sampled evenly (a lattice) have next to no deviation and the
-  // slightly more isolated ones on its edges would go.
-  const double sigma = std::max(1.4826 * Median(dev), 0.2 * median);
+  // Normal-scaled MAD, floored at a fifth of the median: points sampled evenly (a
+  // lattice) have next to no deviation, and the slightly more isolated ones on its edges
+  // would go.
+  const double sigma = std::max(kMadToSigma * MedianAbsoluteDeviation(isolation, median), 0.2 * median);
   // Half the points or more at one place: no scale to measure by.
-  if (!(sigma > 0.0)) return AllIndices(n);
+  if (!(sigma > 0.0)) return finite;
   std::vector<size_t> kept;
   kept.reserve(n);
   for (size_t i = 0; i < n; ++i) {
-    if (isolation[i] <= median + max_mads * sigma) kept.push_back(i);  // NaN: left out
+    if (isolation[i] <= median + max_mads * sigma) kept.push_back(finite[i]);
   }
   return kept;
 }

@@ -79,14 +79,14 @@ struct ObjectReconstructionOptions {
   // ... and only those not isolated: a point whose mean distance to its
   // isolation_neighbours nearest others is more than max_isolation_mads (normal-scaled)
   // median absolute deviations, floored at a fifth of the median, above the median of
-  // that distance is left out (the
-  // statistical outlier removal of point-cloud libraries, with robust statistics). A
-  // feature of another body or of the background that kept with the object for a while
-  // is triangulated off its surface, alone or in a pair, which the single-link cluster
-  // joins to the body when it lies within a few spacings of it. Lockstep,
-  // longest map, shape rmse (% of size): sim-crossing seed 1 2.9 -> 2.2 (34 -> 32
-  // points), seed 2 9.9 -> 2.3 (30 -> 26 points); seed 3, sim-multi seeds 1-3,
-  // sim-following seeds 1-3 and sim-previously_static seeds 1-3 within 0.05 points.
+  // that distance is left out (the statistical outlier removal of point-cloud
+  // libraries, with robust statistics). A feature of another body or of the background
+  // that kept with the object for a while is triangulated off its surface, alone or in a
+  // pair, which the single-link cluster joins to the body when it lies within a few
+  // spacings of it. Lockstep, longest map, shape rmse (% of size): sim-crossing seed 1
+  // 2.9 -> 2.2 (34 -> 32 points), seed 2 9.9 -> 2.3 (30 -> 26 points); seed 3, sim-multi
+  // seeds 1-3, sim-following seeds 1-3 and sim-previously_static seeds 1-3 within 0.05
+  // points.
   int isolation_neighbours = 4;     // (count)
   double max_isolation_mads = 3.0;  // (0 = off)
   // SfM feedback (eq. 6.3-6.4): the reconstruction drives the object's bearing-only
@@ -194,7 +194,7 @@ struct ObjectReconstructionOptions {
     v("min_axis_mad_share", &min_axis_mad_share, "... each axis's deviation floored at this share of the largest");
     v("isolation_neighbours", &isolation_neighbours, "object points: neighbours of the isolation distance (count)");
     v("max_isolation_mads", &max_isolation_mads,
-      "object points published only if their mean distance to their nearest neighbours is within this many MADs above the median (0 = all)");
+      "object points published only if their mean distance to their nearest neighbours is within this many normal-scaled MADs (1.4826 MAD, at least a fifth of the median) above the median (0 = all)");
     v("feedback_to_tracker", &feedback_to_tracker, "the reconstruction drives the object's bearing-only filter (SfM feedback) and relative scale");
     v("rotation_prior_floor_rad", &rotation_prior_floor_rad,
       "the camera's rotation (world SLAM) as a prior on the object's: noise floor (rad; both 0 = off)");
@@ -252,8 +252,9 @@ std::vector<Eigen::Vector3d> AxisCompactPoints(const std::vector<Eigen::Vector3d
                                                double min_mad_share);
 // The points not isolated: each point's mean distance to its `neighbours` nearest others
 // within max_mads normal-scaled median absolute deviations (at least a fifth of the median)
-// above the median of that distance. Fewer than 8 points, at most 2 * neighbours,
-// max_mads 0, or half the points at one place: all.
+// above the median of that distance; non-finite points are left out. max_mads 0 or at
+// most max(7, 2 * neighbours) points: all; the same for the finite ones, or half of them
+// at one place: all finite ones.
 std::vector<Eigen::Vector3d> DensePoints(const std::vector<Eigen::Vector3d>& points, int neighbours,
                                          double max_mads);
 // The same four filters as indices into `points` (ascending).

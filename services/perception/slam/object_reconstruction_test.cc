@@ -253,8 +253,8 @@ TEST(ObjectReconstructionTest, PublishedPointsAreNotIsolated) {
   points.emplace_back(-0.62, 0.1, 0.5);  // a pair off the body's side
   points.emplace_back(-0.6, 0.08, 0.26);
   points.emplace_back(0.1, 0.42, 0.2);   // one behind the front face
-  // The radius and the cluster keep them (on seed 2 the axes' deviations of its sparser,
-  // irregular cloud did too; this regular one's are tighter).
+  // The radius and the cluster keep them. (The axes' deviations of this regular cloud are
+  // tight enough to drop the pair; those of seed 2's sparser, irregular one were not.)
   ASSERT_EQ(CompactPoints(points, 4.0).size(), points.size());
   ASSERT_EQ(LargestCluster(points, 3.0).size(), points.size());
   const std::vector<Eigen::Vector3d> kept = DensePoints(points, 4, 3.0);
@@ -262,18 +262,24 @@ TEST(ObjectReconstructionTest, PublishedPointsAreNotIsolated) {
   for (size_t i = 0; i < body.size(); ++i) EXPECT_EQ(kept[i], body[i]);  // the body, in order
   EXPECT_EQ(DensePoints(body, 4, 3.0).size(), body.size());
   EXPECT_EQ(DensePoints(points, 4, 0.0).size(), points.size());  // 0: everything
-  const std::vector<Eigen::Vector3d> few(points.end() - 8, points.end());
-  EXPECT_EQ(DensePoints(few, 4, 3.0).size(), few.size());  // too few to tell
-  // A regular grid: its edges and corners, a little more isolated than its inside, stay.
+  std::vector<Eigen::Vector3d> few(body.begin(), body.begin() + 6);  // too few to tell
+  few.push_back(points.back());
+  EXPECT_EQ(DensePoints(few, 4, 3.0).size(), few.size());
+  // A regular grid: its edges and corners, a little more isolated than its inside, stay
+  // (without the deviation's floor 28 of them would go).
   std::vector<Eigen::Vector3d> grid;
-  for (int i = 0; i < 5; ++i) {
-    for (int j = 0; j < 5; ++j) grid.emplace_back(0.1 * i, 0.1 * j, 0.0);
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 8; ++j) grid.emplace_back(0.1 * i, 0.1 * j, 0.0);
   }
   EXPECT_EQ(DensePoints(grid, 4, 3.0).size(), grid.size());
   // Most points at one place (no spread of the isolation): all are kept.
   std::vector<Eigen::Vector3d> stacked(12, Eigen::Vector3d(1.0, 2.0, 3.0));
   for (int i = 0; i < 4; ++i) stacked.emplace_back(1.0 + i, 2.0, 3.0);
   EXPECT_EQ(DensePoints(stacked, 4, 3.0).size(), stacked.size());
+  // A non-finite point is never published, and does not switch the filter off.
+  std::vector<Eigen::Vector3d> with_nan = points;
+  with_nan.insert(with_nan.begin() + 3, Eigen::Vector3d(std::nan(""), 0.0, 0.0));
+  EXPECT_EQ(DensePoints(with_nan, 4, 3.0).size(), body.size());
 }
 
 // A person-sized box 6 m away walking across the view of a panning camera, the camera's
@@ -495,8 +501,8 @@ TEST(ObjectReconstructionTest, BodyPointIdsAreTheMaturePointsOnTheBody) {
   EXPECT_LT(compact.size(), mature.size());
   EXPECT_LT(cluster.size(), compact.size());
   EXPECT_LT(chained.size(), cluster.size());
-  // The chain's points the axes keep, 0.1 m apart in a line, are more isolated than the
-  // box's (on the thin side's line only the body's edge is near).
+  // The chain's end that the axes keep, with neighbours on one side only, is more
+  // isolated than the box's points.
   const std::vector<Eigen::Vector3d> dense =
       DensePoints(chained, options.isolation_neighbours, options.max_isolation_mads);
   EXPECT_LT(dense.size(), chained.size());

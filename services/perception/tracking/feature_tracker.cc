@@ -143,7 +143,7 @@ std::optional<ExposureChange> ExposureChangeOfPatches(const std::vector<std::pai
     c.offset = my - c.gain * mx;
     std::vector<double> r(n);  // vertical distances (the gain is near 1)
     for (size_t i = 0; i < n; ++i) r[i] = std::abs(y[i] - (c.gain * x[i] + c.offset));
-    const double sigma = std::max(1.0, 1.4826 * Median(r));
+    const double sigma = std::max(1.0, kMadToSigma * Median(r));
     for (size_t i = 0; i < n; ++i) in[i] = r[i] <= 3.0 * sigma;
   }
   return c;
