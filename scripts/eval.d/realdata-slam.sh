@@ -16,9 +16,13 @@
 #   processed / images: a monocular map starts only after the first pair with enough
 #   parallax), "posed_fraction" (= tracked_fraction, the former name), "ate_rmse_m", "ate_rel_path",
 #   "path_length_m" (all of the first start), "ate_rel_path_live" (the poses as published
-#   live, without the later bundle adjustments the trajectory file follows); with several
+#   live, without the later bundle adjustments the trajectory file follows),
+#   "static_false_moving_fraction", "static_frames_with_moving_share", "static_phantom_objects"
+#   (both scenes are static: the share of the scored features labelled moving, of the
+#   images with any, and the objects, all false; mbslam-eval-realdata static); with several
 #   starts also "starts" (the same keys per start) and "tracked_fraction_mean",
 #   "tracked_fraction_live_mean", "posed_fraction_mean", "ate_rel_path_mean", "ate_rel_path_live_mean",
+#   "static_false_moving_fraction_mean", "static_phantom_objects_mean",
 #   "ate_rel_path_median"}, "tum-cabinet": {...}}
 set -euo pipefail
 source "$(dirname "$0")/_lib.sh"
@@ -69,7 +73,9 @@ run_one() {
   "$MBSLAM_BIN/camera_driver" --source "$source_kind" --input "$data" "${rate_args[@]}" \
     --calibration "$MBSLAM_ROOT/$calib" --log "$log" --quiet --no-progress --log-level warning >&2
   run_service "$log" "$dir/run" ${SERVICE_ARGS:-}
-  local ate ate_live="{}" length
+  local ate ate_live="{}" length static
+  # Both scenes are static: every moving label is false, every object a phantom.
+  static=$(last_json "$MBSLAM_BIN/mbslam-eval-realdata" static --run "$dir/run/out.lcmlog" --name "$name")
   ate=$(last_json "$MBSLAM_BIN/mbslam-eval" ate --est "$dir/run/result/camera_trajectory.tum" --gt-log "$log" \
         --plot "$dir/trajectory.png")
   if [[ -s "$dir/run/result/camera_trajectory_live.tum" ]]; then
@@ -78,10 +84,11 @@ run_one() {
   length=$(awk -v a="$c1" -v b="$c2" -v c="$c3" '!/^#/ && NF >= 7 {
              if (n++) {dx = $a - x; dy = $b - y; dz = $c - z; L += sqrt(dx*dx + dy*dy + dz*dz)}
              x = $a; y = $b; z = $c} END {printf "%.6f\n", L}' "$truth")
-  python3 - "$name" "$dir/run/result/summary.json" "$length" "$ate" "$ate_live" <<'PY'
+  python3 - "$name" "$dir/run/result/summary.json" "$length" "$ate" "$ate_live" "$static" <<'PY'
 import json, sys
 name, summary_path, length, ate = sys.argv[1], sys.argv[2], float(sys.argv[3]), json.loads(sys.argv[4] or "{}")
 ate_live = json.loads(sys.argv[5] or "{}")
+static = json.loads(sys.argv[6] or "{}")
 s = json.load(open(summary_path))
 rmse = ate.get("ate_rmse_m")
 # The file's share of the images, as mbslam-eval counts it for the simulated scenes (the
@@ -95,10 +102,14 @@ r = {"frames": s["frames"], "tracked_fraction": posed, "tracked_fraction_live": 
      "trajectory_fraction_scored": ate.get("fraction_tracked")}
 rmse_live = ate_live.get("ate_rmse_m")
 r["ate_rel_path_live"] = None if rmse_live is None or length <= 0 else rmse_live / length
+r["static_false_moving_fraction"] = static.get("static_false_moving_fraction")
+r["static_frames_with_moving_share"] = static.get("static_frames_with_moving_share")
+r["static_phantom_objects"] = static.get("static_phantom_objects")
 print(f"{name}: {s['frames']} images, tracked (trajectory file) {100 * r['tracked_fraction']:.1f} %, live poses "
       f"{100 * r['tracked_fraction_live']:.1f} %, ATE {rmse} m = "
-      f"{'n/a' if r['ate_rel_path'] is None else round(100 * r['ate_rel_path'], 2)} % of the {length:.2f} m path",
-      file=sys.stderr)
+      f"{'n/a' if r['ate_rel_path'] is None else round(100 * r['ate_rel_path'], 2)} % of the {length:.2f} m path; "
+      f"static scene: {r['static_false_moving_fraction']} of the features labelled moving, "
+      f"{r['static_phantom_objects']} phantom objects", file=sys.stderr)
 print(json.dumps(r))
 PY
 }
@@ -136,7 +147,8 @@ runs = {int(rest[i]): json.loads(rest[i + 1]) for i in range(0, len(rest), 2)}
 first = runs[min(runs)] if 0 not in runs else runs[0]
 out = dict(first)
 out["starts"] = {str(k): v for k, v in runs.items()}
-for key in ("tracked_fraction", "tracked_fraction_live", "posed_fraction", "ate_rel_path", "ate_rel_path_live"):
+for key in ("tracked_fraction", "tracked_fraction_live", "posed_fraction", "ate_rel_path", "ate_rel_path_live",
+            "static_false_moving_fraction", "static_phantom_objects"):
     vals = [v[key] for v in runs.values() if v.get(key) is not None]
     out[key + "_mean"] = statistics.mean(vals) if vals else None
 vals = [v["ate_rel_path"] for v in runs.values() if v.get("ate_rel_path") is not None]

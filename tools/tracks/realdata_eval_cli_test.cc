@@ -157,6 +157,38 @@ TEST_F(RealDataCli, DavisKnownAnswers) {
   EXPECT_TRUE(fs::exists(dir_ / "per_frame/aa.csv"));
 }
 
+// A static scene: every moving label is false, every object a phantom.
+TEST_F(RealDataCli, StaticSceneKnownAnswers) {
+  Status st;
+  auto w = LcmLogWriter::Open((dir_ / "out.lcmlog").string(), &st);
+  ASSERT_TRUE(w);
+  // Image 0: 1 of 4 moving (object 1), one unassigned; image 1: none; image 2: 2 of 4
+  // (objects 1 and 3), one new (not scored).
+  WriteTracks(w.get(), 0, 80, 60,
+              {FeatureTrack(1, 10, 10, 1), FeatureTrack(2, 50, 10, 0), FeatureTrack(3, 50, 20, 0),
+               FeatureTrack(4, 50, 30, -1)},
+              {});
+  WriteTracks(w.get(), 1, 80, 60, {FeatureTrack(1, 10, 10, 0), FeatureTrack(2, 50, 10, 0)}, {});
+  WriteTracks(w.get(), 2, 80, 60,
+              {FeatureTrack(1, 10, 10, 1), FeatureTrack(2, 50, 10, 3), FeatureTrack(3, 50, 20, 0),
+               FeatureTrack(5, 20, 20, 0), FeatureTrack(6, 30, 30, 2, 1, mbslam::feature_track_t::FLAG_NEW)},
+              {});
+  w->Flush();
+  Json j;
+  ASSERT_EQ(RunCli("static --run " + (dir_ / "out.lcmlog").string() + " --name test", &j), 0);
+  EXPECT_DOUBLE_EQ(Get(j, "static_false_moving_fraction"), 3.0 / 10.0);
+  EXPECT_DOUBLE_EQ(Get(j, "static_frames_with_moving_share"), 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(Get(j, "static_phantom_objects"), 2);
+  EXPECT_DOUBLE_EQ(Get(j, "moving_features"), 3);
+  EXPECT_DOUBLE_EQ(Get(j, "features"), 10);
+  EXPECT_DOUBLE_EQ(Get(j, "unassigned_features"), 1);
+  EXPECT_DOUBLE_EQ(Get(j, "frames"), 3);
+  // Bad options and a log without tracks: errors, not figures.
+  EXPECT_EQ(RunCli("static --run " + (dir_ / "out.lcmlog").string() + " --bogus 1", &j), 2);
+  EXPECT_EQ(RunCli("static", &j), 2);
+  EXPECT_EQ(RunCli("static --run " + (dir_ / "missing.lcmlog").string(), &j), 1);
+}
+
 TEST_F(RealDataCli, CamVidKnownAnswers) {
   cv::Mat labels(60, 80, CV_8UC1, cv::Scalar(kCamVidBuilding));
   labels(cv::Rect(40, 0, 40, 60)).setTo(kCamVidCar);

@@ -10,6 +10,9 @@
 //       overall: mean of the sequence means.
 //   mbslam-eval-realdata camvid --root CAMVID_ROOT --run OUT.lcmlog
 //       Where the moving-labelled features fall among CamVid's classes.
+//   mbslam-eval-realdata static --run OUT.lcmlog [--name NAME]
+//       A scene that does not move (TartanAir, TUM cabinet): the share of the features
+//       labelled moving, of the images with any, and the objects (all phantoms).
 //
 // Prints a human summary and, last, one JSON line.
 
@@ -88,6 +91,7 @@ int Usage() {
   std::fprintf(stderr,
                "usage: mbslam-eval-realdata davis --root DAVIS_ROOT --runs DIR [--sequences a,b] [--per-frame-dir DIR]\n"
                "       mbslam-eval-realdata camvid --root CAMVID_ROOT --run OUT.lcmlog\n"
+               "       mbslam-eval-realdata static --run OUT.lcmlog [--name NAME]   (a scene that does not move)\n"
                "diagnostics (both): [--dump FEATURES.csv] [--overlay-dir DIR [--overlay-every N]]\n");
   return 2;
 }
@@ -366,12 +370,39 @@ int RunCamVid(const CommandLineArgs& args) {
   return 0;
 }
 
+// A scene whose world does not move: every moving label is false, every object a phantom.
+int RunStatic(const CommandLineArgs& args) {
+  const std::string log = args.Get("run"), name = args.Get("name", "static");
+  if (!OptionsOk(args)) return Usage();
+  if (log.empty()) return Usage();
+  const ChannelOptions ch;
+  std::map<int64_t, eval::PerceptionFrame> run;
+  int bad = 0;
+  const Status st = eval::ReadPerceptionFrames(log, ch, &run, &bad);
+  if (!st.ok()) return Fail(log + ": " + st.message());
+  const eval::StaticSceneScore s = eval::ScoreStaticScene(run);
+  if (s.frames == 0) return Fail(log + ": no PERCEPTION_TRACKS");
+  std::printf("%s (static scene): %d images, %d scored features, %d labelled moving (%s), in %d images (%s), "
+              "%zu phantom objects, %d unassigned\n",
+              name.c_str(), s.frames, s.features, s.moving, Pct(s.false_moving).c_str(), s.frames_with_moving,
+              Pct(s.frames_with_moving_share).c_str(), s.moving_per_object.size(), s.unassigned);
+  Json j = Json::Object();
+  j.Set("dataset", name).Set("static_false_moving_fraction", s.false_moving);
+  j.Set("static_frames_with_moving_share", s.frames_with_moving_share);
+  j.Set("static_phantom_objects", static_cast<int>(s.moving_per_object.size()));
+  j.Set("moving_features", s.moving).Set("features", s.features).Set("unassigned_features", s.unassigned);
+  j.Set("frames", s.frames).Set("undecodable_messages", bad);
+  std::printf("%s\n", j.Dump().c_str());
+  return 0;
+}
+
 int Run(int argc, char** argv) {
   if (argc < 2) return Usage();
   const std::string cmd = argv[1];
   const CommandLineArgs args(argc, argv, 2);
   if (cmd == "davis") return RunDavis(args);
   if (cmd == "camvid") return RunCamVid(args);
+  if (cmd == "static") return RunStatic(args);
   return Usage();
 }
 

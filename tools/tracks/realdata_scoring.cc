@@ -353,5 +353,32 @@ Status ScoreCamVid(const std::vector<CamVidFrame>& frames,
   return Status::Ok();
 }
 
+void StaticSceneScore::AddFrame(const PerceptionFrame& frame) {
+  if (!frame.has_tracks) return;
+  ++frames;
+  int moving_here = 0;
+  for (size_t i = 0; i < frame.features.size(); ++i) {
+    ++features;
+    if (!frame.features[i].moving) continue;
+    ++moving_here;
+    ++moving_per_object[frame.body_ids[i]];
+  }
+  moving += moving_here;
+  unassigned += frame.num_unassigned;
+  frames_with_moving += moving_here > 0;
+}
+
+void StaticSceneScore::Finish() {
+  false_moving = features > 0 ? static_cast<double>(moving) / features : 0.0;
+  frames_with_moving_share = frames > 0 ? static_cast<double>(frames_with_moving) / frames : 0.0;
+}
+
+StaticSceneScore ScoreStaticScene(const std::map<int64_t, PerceptionFrame>& run) {
+  StaticSceneScore score;
+  for (const auto& [seq, frame] : run) score.AddFrame(frame);
+  score.Finish();
+  return score;
+}
+
 }  // namespace eval
 }  // namespace mbslam

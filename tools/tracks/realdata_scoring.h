@@ -179,6 +179,27 @@ struct CamVidRunScore {
 Status ScoreCamVid(const std::vector<CamVidFrame>& frames,
                    const std::map<int64_t, PerceptionFrame>& run, CamVidRunScore* score);
 
+// ---------------------------------------------------------------- static scenes
+
+// A sequence whose world does not move (TartanAir, TUM cabinet): every feature labelled
+// moving is a false one, and every object a phantom.
+struct StaticSceneScore {
+  int frames = 0;               // images with tracks from the run (count)
+  int features = 0;             // scored features (count)
+  int moving = 0;               // of them labelled moving (body_id > 0) (count)
+  int unassigned = 0;           // of them with body_id < 0 (count)
+  int frames_with_moving = 0;   // images with at least one feature labelled moving (count)
+  std::map<int, int> moving_per_object;  // object id -> moving-labelled features (phantoms)
+  // Derived (Finish()):
+  double false_moving = 0.0;              // moving / features (0 without features)
+  double frames_with_moving_share = 0.0;  // frames_with_moving / frames
+  void AddFrame(const PerceptionFrame& frame);
+  void Finish();
+};
+
+// Scores every image of a run on a static scene.
+StaticSceneScore ScoreStaticScene(const std::map<int64_t, PerceptionFrame>& run);
+
 }  // namespace eval
 }  // namespace mbslam
 
