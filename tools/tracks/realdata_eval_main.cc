@@ -385,11 +385,11 @@ int RunStatic(const CommandLineArgs& args) {
   std::printf("%s (static scene): %d images, %d scored features, %d labelled moving (%s), in %d images (%s), "
               "%zu phantom objects, %d unassigned\n",
               name.c_str(), s.frames, s.features, s.moving, Pct(s.false_moving).c_str(), s.frames_with_moving,
-              Pct(s.frames_with_moving_share).c_str(), s.moving_per_object.size(), s.unassigned);
+              Pct(s.frames_with_moving_share).c_str(), s.objects.size(), s.unassigned);
   Json j = Json::Object();
   j.Set("dataset", name).Set("static_false_moving_fraction", s.false_moving);
   j.Set("static_frames_with_moving_share", s.frames_with_moving_share);
-  j.Set("static_phantom_objects", static_cast<int>(s.moving_per_object.size()));
+  j.Set("static_phantom_objects", static_cast<int>(s.objects.size()));
   j.Set("moving_features", s.moving).Set("features", s.features).Set("unassigned_features", s.unassigned);
   j.Set("frames", s.frames).Set("undecodable_messages", bad);
   std::printf("%s\n", j.Dump().c_str());

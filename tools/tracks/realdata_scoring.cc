@@ -361,7 +361,7 @@ void StaticSceneScore::AddFrame(const PerceptionFrame& frame) {
     ++features;
     if (!frame.features[i].moving) continue;
     ++moving_here;
-    ++moving_per_object[frame.body_ids[i]];
+    objects.insert(frame.body_ids[i]);
   }
   moving += moving_here;
   unassigned += frame.num_unassigned;

@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -189,7 +190,7 @@ struct StaticSceneScore {
   int moving = 0;               // of them labelled moving (body_id > 0) (count)
   int unassigned = 0;           // of them with body_id < 0 (count)
   int frames_with_moving = 0;   // images with at least one feature labelled moving (count)
-  std::map<int, int> moving_per_object;  // object id -> moving-labelled features (phantoms)
+  std::set<int> objects;        // ids of the objects the moving features belong to (phantoms)
   // Derived (Finish()):
   double false_moving = 0.0;              // moving / features (0 without features)
   double frames_with_moving_share = 0.0;  // frames_with_moving / frames

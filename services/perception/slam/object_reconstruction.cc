@@ -46,6 +46,16 @@ std::vector<T> Select(const std::vector<T>& items, const std::vector<size_t>& in
   return out;
 }
 
+// The indices of the finite points.
+std::vector<size_t> FiniteIndices(const std::vector<Eigen::Vector3d>& points) {
+  std::vector<size_t> finite;
+  finite.reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (points[i].allFinite()) finite.push_back(i);
+  }
+  return finite;
+}
+
 // The per-coordinate median of the points.
 Eigen::Vector3d MedianCentre(const std::vector<Eigen::Vector3d>& points) {
   std::vector<double> coords[3];
@@ -130,11 +140,7 @@ std::vector<Eigen::Vector3d> CompactPoints(const std::vector<Eigen::Vector3d>& p
 std::vector<size_t> AxisCompactIndices(const std::vector<Eigen::Vector3d>& in, double max_mads,
                                        double min_mad_share) {
   if (max_mads <= 0.0 || in.size() < 8) return AllIndices(in.size());
-  std::vector<size_t> finite;  // a non-finite point is never published
-  finite.reserve(in.size());
-  for (size_t i = 0; i < in.size(); ++i) {
-    if (in[i].allFinite()) finite.push_back(i);
-  }
+  const std::vector<size_t> finite = FiniteIndices(in);  // a non-finite point is never published
   if (finite.size() < 8) return finite;
   const std::vector<Eigen::Vector3d> points = Select(in, finite);
   const Eigen::Vector3d centre = MedianCentre(points);
@@ -180,11 +186,7 @@ std::vector<size_t> AxisCompactIndices(const std::vector<Eigen::Vector3d>& in, d
 std::vector<size_t> DenseIndices(const std::vector<Eigen::Vector3d>& in, int neighbours, double max_mads) {
   const size_t k = static_cast<size_t>(std::max(neighbours, 1));
   if (max_mads <= 0.0 || in.size() < 8 || in.size() <= 2 * k) return AllIndices(in.size());
-  std::vector<size_t> finite;  // a non-finite point is never published
-  finite.reserve(in.size());
-  for (size_t i = 0; i < in.size(); ++i) {
-    if (in[i].allFinite()) finite.push_back(i);
-  }
+  const std::vector<size_t> finite = FiniteIndices(in);  // a non-finite point is never published
   const std::vector<Eigen::Vector3d> points = Select(in, finite);
   const size_t n = points.size();
   if (n < 8 || n <= 2 * k) return finite;
