@@ -642,11 +642,13 @@ int RunReconstructions(const mbslam::CommandLineArgs& args) {
     std::printf(
         "  object %d map %lld -> body %d (%s): %d images, trajectory %.3f m = %.2f %% of the %.2f m path "
         "(%.2f %% of the %.2f m range); %d points, shape rmse %.3f m = %.2f %% of the %.2f m size (median "
-        "%.2f %%, %.0f %% within 2 %%)\n",
+        "%.2f %%, %.0f %% within 2 %%); after the points' rigid fit %.2f %% (median %.2f %%; moved %.2f deg, "
+        "%.3f m)\n",
         r.object_id, static_cast<long long>(r.map_id), r.gt_id, r.gt_name.c_str(), r.samples, r.trajectory_rmse_m,
         100.0 * r.trajectory_err_rel_path, r.path_length_m, 100.0 * r.trajectory_err_rel_range, r.mean_range_m,
         r.num_points, r.shape_rmse_m, 100.0 * r.shape_err_rel, r.size_m, 100.0 * r.shape_err_rel_median,
-        100.0 * r.share_within_2pct);
+        100.0 * r.share_within_2pct, 100.0 * r.shape_rigid_err_rel, 100.0 * r.shape_rigid_err_rel_median,
+        r.rigid_fit_rotation_deg, r.rigid_fit_translation_m);
     Json o = Json::Object();
     o.Set("object_id", r.object_id).Set("map_id", static_cast<int64_t>(r.map_id)).Set("gt_id", r.gt_id);
     o.Set("name", r.gt_name).Set("samples", r.samples).Set("scale", r.scale);
@@ -655,6 +657,8 @@ int RunReconstructions(const mbslam::CommandLineArgs& args) {
     o.Set("trajectory_err_rel_range", r.trajectory_err_rel_range).Set("points", r.num_points);
     o.Set("shape_rmse_m", r.shape_rmse_m).Set("shape_err_rel", r.shape_err_rel);
     o.Set("shape_err_rel_median", r.shape_err_rel_median).Set("share_within_2pct", r.share_within_2pct);
+    o.Set("shape_rigid_err_rel", r.shape_rigid_err_rel).Set("shape_rigid_err_rel_median", r.shape_rigid_err_rel_median);
+    o.Set("rigid_fit_rotation_deg", r.rigid_fit_rotation_deg).Set("rigid_fit_translation_m", r.rigid_fit_translation_m);
     list.Push(o);
     if (!longest || r.samples > longest->samples) longest = &r;
   }
@@ -663,13 +667,17 @@ int RunReconstructions(const mbslam::CommandLineArgs& args) {
   j.Set("scored", static_cast<int64_t>(results.size()));
   if (longest) {
     // The headline is the longest-lived reconstruction (not the best one).
-    std::printf("longest: object %d map %lld (%s), %d images: trajectory %.2f %% of path, shape %.2f %% of size\n",
-                longest->object_id, static_cast<long long>(longest->map_id), longest->gt_name.c_str(),
-                longest->samples, 100.0 * longest->trajectory_err_rel_path, 100.0 * longest->shape_err_rel);
+    std::printf(
+        "longest: object %d map %lld (%s), %d images: trajectory %.2f %% of path, shape %.2f %% of size (%.2f %% "
+        "after the points' rigid fit)\n",
+        longest->object_id, static_cast<long long>(longest->map_id), longest->gt_name.c_str(), longest->samples,
+        100.0 * longest->trajectory_err_rel_path, 100.0 * longest->shape_err_rel, 100.0 * longest->shape_rigid_err_rel);
     j.Set("object_traj_err_rel", longest->trajectory_err_rel_path)
         .Set("object_traj_err_rel_range", longest->trajectory_err_rel_range)
         .Set("object_shape_err_rel", longest->shape_err_rel)
         .Set("object_shape_err_rel_median", longest->shape_err_rel_median)
+        .Set("object_shape_rigid_err_rel", longest->shape_rigid_err_rel)
+        .Set("object_shape_rigid_err_rel_median", longest->shape_rigid_err_rel_median)
         .Set("object_reconstruction_images", longest->samples)
         .Set("object_reconstruction_body", longest->gt_name);
   }

@@ -37,6 +37,77 @@ double BoxSurfaceDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& exten
   return outside > 0.0 ? outside : -inside;
 }
 
+double BoxSignedDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent) {
+  const Eigen::Vector3d q = p.cwiseAbs() - 0.5 * extent;
+  const double outside = q.cwiseMax(0.0).norm();
+  return outside > 0.0 ? outside : q.maxCoeff();
+}
+
+Rigid3d FitPointsToBoxSurface(const Eigen::Vector3d& extent, std::vector<Eigen::Vector3d>* points) {
+  Rigid3d moved;  // identity
+  // Six points or fewer can be put on almost any surface by the six parameters.
+  if (points->size() < 7) return moved;
+  const auto cost_of = [&](const std::vector<Eigen::Vector3d>& pts) {
+    double c = 0.0;
+    for (const Eigen::Vector3d& p : pts) c += std::pow(BoxSignedDistance(p, extent), 2);
+    return c;
+  };
+  // A left perturbation q -> q + v + w x q about the points' centroid, which keeps the
+  // rotation and translation directions well conditioned.
+  double cost = cost_of(*points);
+  double lambda = 1e-3;
+  const double h = 1e-6 * std::max(1.0, extent.maxCoeff());
+  for (int iter = 0; iter < 100; ++iter) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& p : *points) c += p;
+    c /= static_cast<double>(points->size());
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    for (const Eigen::Vector3d& p : *points) {
+      const double r = BoxSignedDistance(p, extent);
+      Eigen::Vector3d grad;
+      for (int k = 0; k < 3; ++k) {
+        Eigen::Vector3d dp = Eigen::Vector3d::Zero();
+        dp[k] = h;
+        grad[k] = (BoxSignedDistance(p + dp, extent) - BoxSignedDistance(p - dp, extent)) / (2.0 * h);
+      }
+      Eigen::Matrix<double, 1, 6> J;
+      J.head<3>() = grad.transpose();
+      J.tail<3>() = (p - c).cross(grad).transpose();  // d/dw of grad . (w x (p - c))
+      H += J.transpose() * J;
+      g += J.transpose() * r;
+    }
+    bool improved = false;
+    while (lambda < 1e8) {
+      Eigen::Matrix<double, 6, 6> A = H;
+      A.diagonal() += lambda * (H.diagonal().array() + 1e-9).matrix();
+      const Eigen::Matrix<double, 6, 1> delta = -A.ldlt().solve(g);
+      if (!delta.allFinite()) break;
+      const Eigen::Vector3d w = delta.tail<3>();
+      const double angle = w.norm();
+      const Eigen::Quaterniond dq =
+          angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle)) : Eigen::Quaterniond::Identity();
+      // x -> dq (x - c) + c + v
+      const Rigid3d step(dq, c + delta.head<3>() - dq * c);
+      std::vector<Eigen::Vector3d> trial;
+      trial.reserve(points->size());
+      for (const Eigen::Vector3d& p : *points) trial.push_back(step * p);
+      const double trial_cost = cost_of(trial);
+      if (trial_cost < cost) {
+        *points = std::move(trial);
+        moved = step * moved;
+        improved = cost - trial_cost > 1e-12 * std::max(cost, 1e-12);
+        cost = trial_cost;
+        lambda = std::max(1e-6, lambda * 0.3);
+        break;
+      }
+      lambda *= 10.0;
+    }
+    if (!improved) break;
+  }
+  return moved;
+}
+
 Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<int, BodyTruth>& truth,
                               const Trajectory& gt_world_from_cam, int64_t max_time_diff_us, int min_samples,
                               ReconstructionResult* result) {
@@ -97,6 +168,22 @@ Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<
       r.shape_err_rel_median = r.shape_median_m / r.size_m;
     }
     r.share_within_2pct = d.empty() ? 0.0 : static_cast<double>(within) / static_cast<double>(d.size());
+    std::vector<Eigen::Vector3d> fitted = best_points;
+    const Rigid3d fit = FitPointsToBoxSurface(body.extent, &fitted);
+    std::vector<double> d_rigid;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (size_t i = 0; i < fitted.size(); ++i) {
+      d_rigid.push_back(BoxSurfaceDistance(fitted[i], body.extent));
+      centroid += best_points[i];
+    }
+    if (!fitted.empty()) centroid /= static_cast<double>(fitted.size());
+    r.shape_rigid_rmse_m = Rms(d_rigid);
+    if (r.size_m > 0.0) {
+      r.shape_rigid_err_rel = r.shape_rigid_rmse_m / r.size_m;
+      r.shape_rigid_err_rel_median = Median(d_rigid) / r.size_m;
+    }
+    r.rigid_fit_rotation_deg = Eigen::AngleAxisd(fit.rotation).angle() * 180.0 / M_PI;
+    r.rigid_fit_translation_m = (fit * centroid - centroid).norm();
   }
   if (found && std::getenv("EVAL_DUMP_SHAPE")) {
     // Each scored point in the body's frame with its distance to the body's surface.

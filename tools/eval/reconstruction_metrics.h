@@ -9,7 +9,13 @@
 //     and translation by least squares); RMSE over the path length and the mean range;
 //   shape: the object's points through that similarity, distance to the surface of the
 //     body's true box (origin at its centre, extent along body x y z), over its size
-//     (the largest extent).
+//     (the largest extent);
+//   shape after a rigid fit: the same points, moved by the rotation and translation
+//     (scale kept) that bring them closest to that surface. The trajectory's similarity
+//     carries its own error onto the points through a lever arm: an error of a tenth of a
+//     degree in the orientations that fix its rotation moves the points, 6-7 m from the
+//     camera path, by about a centimetre, which is not an error of the shape itself. The
+//     scale stays the trajectory's: with a free scale the points would shrink onto one face.
 // Each reconstruction is matched to the body it fits best.
 
 #include <map>
@@ -51,10 +57,25 @@ struct ReconstructionResult {
   double shape_err_rel = 0.0;         // shape_rmse_m / size_m
   double shape_err_rel_median = 0.0;  // shape_median_m / size_m
   double share_within_2pct = 0.0;     // points within 2 % of the size of the surface
+  // After the rigid fit of the points to the surface (scale kept).
+  double shape_rigid_rmse_m = 0.0;
+  double shape_rigid_err_rel = 0.0;          // shape_rigid_rmse_m / size_m
+  double shape_rigid_err_rel_median = 0.0;
+  double rigid_fit_rotation_deg = 0.0;       // how far the fit moved the points: rotation
+  double rigid_fit_translation_m = 0.0;      // ... and translation at their centroid
 };
 
 // Distance of p to the surface of the box of full size `extent` centred at the origin.
 double BoxSurfaceDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent);
+
+// Signed distance of p to the surface of that box: negative inside.
+double BoxSignedDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent);
+
+// The rigid motion (applied in the box's frame) that brings `points` closest to the
+// surface of the box of full size `extent` centred at the origin, in the least-squares
+// sense (Levenberg-Marquardt from the identity); the points are replaced by the moved ones.
+// Fewer than 7 points are left as they are (six parameters fit almost any six points).
+Rigid3d FitPointsToBoxSurface(const Eigen::Vector3d& extent, std::vector<Eigen::Vector3d>* points);
 
 // Matches `est` to the body of `truth` whose true camera-relative trajectory it fits best
 // (lowest trajectory error over the mean range); needs >= min_samples common images.

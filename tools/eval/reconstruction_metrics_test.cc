@@ -61,9 +61,50 @@ TEST(ReconstructionMetricsTest, ExactReconstructionThroughASimilarityScoresZero)
   est.points = {map_from_body * Eigen::Vector3d(2.52, 0.0, 0.0)};
   ASSERT_TRUE(EvaluateReconstruction(est, truth, cam, 20000, 10, &r).ok());
   EXPECT_NEAR(r.shape_err_rel, 0.1, 1e-6);
+  EXPECT_NEAR(r.shape_rigid_err_rel, 0.1, 1e-6) << "too few points to fit (six or fewer fit any surface)";
   // Too few common images: refused.
   est.obj_from_cam.resize(5);
   EXPECT_FALSE(EvaluateReconstruction(est, truth, cam, 20000, 10, &r).ok());
+}
+
+TEST(ReconstructionMetricsTest, BoxSignedDistanceIsNegativeInside) {
+  const Eigen::Vector3d e(4.0, 2.0, 1.0);
+  EXPECT_NEAR(BoxSignedDistance(Eigen::Vector3d(0.0, 0.0, 0.0), e), -0.5, 1e-12);
+  EXPECT_NEAR(BoxSignedDistance(Eigen::Vector3d(3.0, 0.0, 0.0), e), 1.0, 1e-12);
+  EXPECT_NEAR(BoxSignedDistance(Eigen::Vector3d(1.5, 0.0, 0.0), e), -0.5, 1e-12);
+}
+
+// Points on three faces of a box, displaced by a small rigid motion: the fit brings them
+// back onto the surface; points that are not on the surface in any pose (a bump) stay off.
+TEST(ReconstructionMetricsTest, RigidFitUndoesADisplacementButNotAShapeError) {
+  const Eigen::Vector3d e(0.5, 0.6, 1.8);
+  std::vector<Eigen::Vector3d> surface;
+  for (int i = -2; i <= 2; ++i) {
+    for (int j = -4; j <= 4; ++j) {
+      surface.emplace_back(0.25, 0.12 * i, 0.2 * j);   // front face (+x)
+      surface.emplace_back(0.1 * i, -0.3, 0.2 * j);    // side face (-y)
+    }
+    surface.emplace_back(0.1 * i, 0.1 * i, 0.9);       // top face
+  }
+  const Rigid3d offset(Eigen::Quaterniond(Eigen::AngleAxisd(0.03, Eigen::Vector3d(1, -2, 0.5).normalized())),
+                       Eigen::Vector3d(0.03, -0.02, 0.04));
+  std::vector<Eigen::Vector3d> pts;
+  double before = 0.0;
+  for (const Eigen::Vector3d& p : surface) {
+    pts.push_back(offset * p);
+    before = std::max(before, BoxSurfaceDistance(pts.back(), e));
+  }
+  ASSERT_GT(before, 0.03);
+  const Rigid3d fit = FitPointsToBoxSurface(e, &pts);
+  for (const Eigen::Vector3d& p : pts) EXPECT_LT(BoxSurfaceDistance(p, e), 1e-4);
+  EXPECT_GT(Eigen::AngleAxisd(fit.rotation).angle(), 0.02);
+  // A bump of 0.1 m on the front face is a shape error no rigid motion removes.
+  std::vector<Eigen::Vector3d> bumped = surface;
+  for (int k = 0; k < 6; ++k) bumped[2 * k] += Eigen::Vector3d(0.1, 0.0, 0.0);
+  FitPointsToBoxSurface(e, &bumped);
+  double sum2 = 0.0;
+  for (const Eigen::Vector3d& p : bumped) sum2 += std::pow(BoxSurfaceDistance(p, e), 2);
+  EXPECT_GT(std::sqrt(sum2 / static_cast<double>(bumped.size())), 0.01);
 }
 
 }  // namespace
