@@ -498,6 +498,9 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     ScopedStageTimer timer(tracking_timer_);
     TrackingHints hints;
     hints.occluders = occluders_;
+    if (const auto prev = frame_utime_.find(frame_index_ - 1); prev != frame_utime_.end() && frame.utime > prev->second) {
+      hints.interval_us = frame.utime - prev->second;
+    }
     tracker_.TrackFrame(pyramid_, frame_index_, hints);
   }
   if (GetLogLevel() <= LogLevel::kDebug) {

@@ -544,7 +544,9 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   // Wide baseline: when KLT kept too few, ORB descriptors re-match the lost tracks.
   if (options_.descriptor_fallback && !prev_pts.empty() &&
       static_cast<double>(stats_.tracked) < options_.fallback_survival * static_cast<double>(prev_pts.size())) {
-    MatchByDescriptors(prev_pyramid_[0], image, frame_index, &recently_lost_, &next_tracks);
+    const bool wide_baseline = options_.wide_baseline_min_interval_us > 0 &&
+                               hints.interval_us >= options_.wide_baseline_min_interval_us;
+    MatchByDescriptors(prev_pyramid_[0], image, frame_index, wide_baseline, &recently_lost_, &next_tracks);
   }
 
   // Tracks coming out from behind a hull: re-found on their template.
@@ -611,9 +613,14 @@ int FeatureTracker::GuidedMatch(const std::unordered_map<int64_t, Eigen::Vector2
 }
 
 void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat& image, int64_t frame_index,
-                                        std::vector<Track>* lost, std::vector<Track>* next_tracks) {
+                                        bool wide_baseline, std::vector<Track>* lost,
+                                        std::vector<Track>* next_tracks) {
   if (lost->empty()) return;
-  cv::Ptr<cv::ORB> orb = cv::ORB::create(options_.fallback_features);
+  cv::Ptr<cv::ORB> orb =
+      wide_baseline ? cv::ORB::create(options_.fallback_features, 1.2f, /*nlevels=*/1, /*edgeThreshold=*/31,
+                                      /*firstLevel=*/0, /*WTA_K=*/2, cv::ORB::HARRIS_SCORE, /*patchSize=*/31,
+                                      options_.wide_baseline_fast_threshold)
+                    : cv::ORB::create(options_.fallback_features);
   // Descriptors of the lost tracks at their previous positions.
   std::vector<cv::KeyPoint> prev_kps;
   for (const Track& t : *lost) {
@@ -623,7 +630,7 @@ void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat
       if (angle < 0.0f) continue;  // ORB would drop it at the border anyway
       prev_kps.emplace_back(pt, 31.0f, angle);
     } else {
-      prev_kps.emplace_back(pt, 31.0f);
+      prev_kps.emplace_back(pt, 31.0f, wide_baseline ? 0.0f : -1.0f);
     }
   }
   cv::Mat prev_desc;
@@ -631,7 +638,14 @@ void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat
   if (prev_kps.empty()) return;
   std::vector<cv::KeyPoint> kps;
   cv::Mat desc;
-  orb->detectAndCompute(image, cv::noArray(), kps, desc);
+  if (wide_baseline && !options_.fallback_orientation) {
+    // Unoriented like the lost tracks' descriptors.
+    orb->detect(image, kps);
+    for (cv::KeyPoint& kp : kps) kp.angle = 0.0f;
+    orb->compute(image, kps, desc);
+  } else {
+    orb->detectAndCompute(image, cv::noArray(), kps, desc);
+  }
   if (kps.size() < 2) return;
   const float radius = static_cast<float>(options_.fallback_radius * std::hypot(image.cols, image.rows));
   // For each lost track (by surviving keypoint), the best and second-best candidates.

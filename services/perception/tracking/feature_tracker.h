@@ -81,8 +81,17 @@ struct TrackerOptions {
   // image's keypoints do: unoriented they match only where the view has not turned (a
   // 25 deg turn: 12 re-found against 140). Off by default: on TartanAir the re-found
   // tracks (ORB keypoint positions) make the ATE worse, mean over five starts 1.09 ->
-  // 1.88 % of the path; TUM cabinet still does not initialise.
+  // 1.88 % of the path; TUM cabinet still does not initialise. Both sides follow it in
+  // the wide-baseline fallback (below).
   bool fallback_orientation = false;
+  // Images this far apart or more (a low frame rate) are a wide baseline: the fallback
+  // then describes both sides alike, on one pyramid level (the lost tracks' descriptors
+  // are single-level; against ORB's 8 levels they matched 8 of hundreds on TUM cabinet,
+  // 1.5 Hz), with the orientation as fallback_orientation says on both sides, and detects
+  // with a lower FAST threshold (wide_baseline_fast_threshold). At video rates the usual
+  // fallback stays: the consistent one made TartanAir (10 Hz) worse (0.83 -> 1.16 % ATE).
+  int64_t wide_baseline_min_interval_us = 200000;  // 0 = never
+  int wide_baseline_fast_threshold = 7;            // FAST threshold of the wide-baseline fallback (gray levels)
   // A glitch image (a flash, a corrupted or foreign frame) loses nearly every established
   // track at once: the image is rejected, the tracks are kept and the next image is
   // tracked from the last good one. Not twice in a row (a real change of view is taken).
@@ -149,6 +158,8 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION(warp_rereference_scale >= 1.0 && warp_rereference_scale <= warp_max_scale);
     MBSLAM_CHECK_OPTION_GE(warp_ground_band, 0.0);
     MBSLAM_CHECK_OPTION(fallback_survival >= 0.0 && fallback_survival <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(wide_baseline_min_interval_us, 0);
+    MBSLAM_CHECK_OPTION(wide_baseline_fast_threshold >= 1 && wide_baseline_fast_threshold <= 255);
     MBSLAM_CHECK_OPTION_GT(fallback_features, 0);
     MBSLAM_CHECK_OPTION(fallback_max_hamming > 0 && fallback_max_hamming <= 256);
     MBSLAM_CHECK_OPTION(fallback_ratio > 0.0 && fallback_ratio <= 1.0);
@@ -212,6 +223,10 @@ struct TrackerOptions {
     v("fallback_radius", &fallback_radius, "fallback search radius (fraction of the diagonal)");
     v("fallback_orientation", &fallback_orientation,
       "the lost tracks' ORB descriptors are oriented (intensity centroid), as the new image's keypoints are");
+    v("wide_baseline_min_interval_us", &wide_baseline_min_interval_us,
+      "images this far apart are a wide baseline: the fallback describes both sides alike on one level (us, 0 = never)");
+    v("wide_baseline_fast_threshold", &wide_baseline_fast_threshold,
+      "FAST threshold of the wide-baseline fallback (gray levels)");
     v("glitch_max_survival", &glitch_max_survival,
       "established tracks matched below this share: the image is a glitch, rejected, tracks kept (0 = off)");
     v("glitch_min_tracks", &glitch_min_tracks, "glitch test only with this many established tracks (count)");
@@ -242,6 +257,7 @@ struct TrackingHints {
     int age_frames = 0;  // images since the object was first segmented
   };
   std::vector<Hull> occluders;
+  int64_t interval_us = 0;  // time since the previous image (0 = unknown)
 };
 
 // A track's reference appearance warped into the latest image: `cur_from_ref` maps
@@ -325,8 +341,9 @@ class FeatureTracker {
   int DetectOnObjects(const cv::Mat& image, int64_t frame_index, const std::vector<TrackingHints::Hull>& hulls);
   void EnforceUnicity();
   std::unordered_map<int64_t, size_t> IndexById() const;  // track id -> index in tracks_
-  // Wide-baseline fallback: lost tracks re-matched by ORB descriptors.
-  void MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat& image, int64_t frame_index,
+  // Fallback: lost tracks re-matched by ORB descriptors. `wide_baseline`: both sides
+  // described alike (TrackerOptions::wide_baseline_min_interval_us).
+  void MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat& image, int64_t frame_index, bool wide_baseline,
                           std::vector<Track>* lost, std::vector<Track>* next_tracks);
 
   const TrackerOptions options_;
