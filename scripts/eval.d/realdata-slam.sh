@@ -22,7 +22,7 @@
 #   images with any, and the objects, all false; mbslam-eval-realdata static); with several
 #   starts also "starts" (the same keys per start) and "tracked_fraction_mean",
 #   "tracked_fraction_live_mean", "posed_fraction_mean", "ate_rel_path_mean", "ate_rel_path_live_mean",
-#   "static_false_moving_fraction_mean", "static_phantom_objects_mean",
+#   "static_false_moving_fraction_mean", "static_frames_with_moving_share_mean", "static_phantom_objects_mean",
 #   "ate_rel_path_median"}, "tum-cabinet": {...}}
 set -euo pipefail
 source "$(dirname "$0")/_lib.sh"
@@ -148,14 +148,17 @@ first = runs[min(runs)] if 0 not in runs else runs[0]
 out = dict(first)
 out["starts"] = {str(k): v for k, v in runs.items()}
 for key in ("tracked_fraction", "tracked_fraction_live", "posed_fraction", "ate_rel_path", "ate_rel_path_live",
-            "static_false_moving_fraction", "static_phantom_objects"):
+            "static_false_moving_fraction", "static_frames_with_moving_share", "static_phantom_objects"):
     vals = [v[key] for v in runs.values() if v.get(key) is not None]
     out[key + "_mean"] = statistics.mean(vals) if vals else None
 vals = [v["ate_rel_path"] for v in runs.values() if v.get("ate_rel_path") is not None]
 out["ate_rel_path_median"] = statistics.median(vals) if vals else None
 print(f"{name} over starts {sorted(runs)}: tracked (trajectory file) {100 * out['tracked_fraction_mean']:.1f} %, live poses "
       f"{100 * out['tracked_fraction_live_mean']:.1f} %, ATE mean {100 * out['ate_rel_path_mean']:.2f} % "
-      f"(median {100 * out['ate_rel_path_median']:.2f} %) of the path", file=sys.stderr)
+      f"(median {100 * out['ate_rel_path_median']:.2f} %) of the path; static scene: "
+      f"{100 * (out['static_false_moving_fraction_mean'] or 0):.1f} % of the features labelled moving, in "
+      f"{100 * (out['static_frames_with_moving_share_mean'] or 0):.0f} % of the images, "
+      f"{out['static_phantom_objects_mean'] or 0:.1f} phantom objects (means)", file=sys.stderr)
 print(json.dumps({name: out}))
 PY
 )")
