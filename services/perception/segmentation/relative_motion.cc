@@ -290,10 +290,15 @@ int RotationGivenHeading(const std::vector<Eigen::Vector2d>& x_r, const std::vec
     *c = a.dot(b);
     *g = -(Hat(b).transpose() * a);  // a' (w x b) = a' (-[b]x w)
   };
-  auto count = [&](const Eigen::Matrix3d& R) {
+  // Inliers of R; stops early (returning at most `to_beat`) once the rest cannot make
+  // more than `to_beat`: only a larger count is kept, so the result is the same.
+  auto count = [&](const Eigen::Matrix3d& R, int to_beat) {
     const Eigen::Matrix3d E = Tx * R;
     int k = 0;
-    for (size_t i = 0; i < n; ++i) k += std::abs(EpipolarDistance(E, x_r[i], x_n[i])) <= thresh;
+    for (size_t i = 0; i < n; ++i) {
+      k += std::abs(EpipolarDistance(E, x_r[i], x_n[i])) <= thresh;
+      if (k + static_cast<int>(n - 1 - i) <= to_beat) return std::min(k, to_beat);
+    }
     return k;
   };
   auto solve = [&](const Eigen::Matrix3d& R, const size_t* idx, size_t m, Eigen::Matrix3d* out) {
@@ -320,7 +325,7 @@ int RotationGivenHeading(const std::vector<Eigen::Vector2d>& x_r, const std::vec
     state ^= state << 17;
     return state;
   };
-  int best_count = count(R0);
+  int best_count = count(R0, -1);
   Eigen::Matrix3d best_R = R0;
   for (int it = 0; it < iterations; ++it) {
     size_t idx[3];
@@ -330,7 +335,7 @@ int RotationGivenHeading(const std::vector<Eigen::Vector2d>& x_r, const std::vec
     if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2]) continue;
     Eigen::Matrix3d R1, R2;
     if (!solve(R0, idx, 3, &R1) || !solve(R1, idx, 3, &R2)) continue;
-    const int k = count(R2);
+    const int k = count(R2, best_count);
     if (k > best_count) {
       best_count = k;
       best_R = R2;
