@@ -107,7 +107,7 @@ out = {"scenario": name, "path_length_m": length, "camera_height_m_given": float
        "object_traj_err_rel": rec.get("object_traj_err_rel"),
        "object_shape_err_rel": rec.get("object_shape_err_rel"),
        "object_shape_err_rel_median": rec.get("object_shape_err_rel_median"),
-       "object_shape_rigid_err_rel": rec.get("object_shape_rigid_err_rel"),
+       "object_shape_translated_err_rel": rec.get("object_shape_translated_err_rel"),
        "object_reconstruction_images": rec.get("object_reconstruction_images"),
        "object_reconstruction_body": rec.get("object_reconstruction_body"),
        "timings_ms": {k: v.get("mean_ms") for k, v in summary.get("timings", {}).items()}}
@@ -141,7 +141,7 @@ if rec.get("scored"):
           f"({rec.get('object_reconstruction_body')}, {rec.get('object_reconstruction_images')} images): camera-relative "
           f"trajectory {pct(rec.get('object_traj_err_rel'))} of its path, shape {pct(rec.get('object_shape_err_rel'))} "
           f"of the size (median {pct(rec.get('object_shape_err_rel_median'))}; "
-          f"{pct(rec.get('object_shape_rigid_err_rel'))} after the points' rigid fit)")
+          f"{pct(rec.get('object_shape_translated_err_rel'))} shifted onto the box)")
 if occ:
     print(f"  occupancy: precision {occ.get('occupancy_precision')}, recall {occ.get('occupancy_recall')} (voxel {occ.get('resolution_m')} m)")
 if ate_nf:

@@ -40,7 +40,7 @@ keys = ["ate_rel_path", "tracked_fraction", "tracked_fraction_live", "scale_erro
         "predicted_hit_rate_0_5s_all_estimates", "predicted_hit_rate_1s_all_estimates",
         "predicted_overlap_rate_1s_all_estimates",
         "object_samples_matched_share", "object_samples_phantom_share", "occupancy_precision",
-        "occupancy_recall", "object_traj_err_rel", "object_shape_err_rel", "object_shape_rigid_err_rel",
+        "occupancy_recall", "object_traj_err_rel", "object_shape_err_rel", "object_shape_translated_err_rel",
         "track_misclassification",
         "ate_rel_path_no_feedback", "feedback_ablation_ratio", "moving_recall_epipolar_only"]
 args = sys.argv[1:]

@@ -608,6 +608,15 @@ int RunObjects(const mbslam::CommandLineArgs& args) {
 
 // ---------------------------------------------------------------- reconstructions
 
+// The shape after the points' own shift, or why there is none.
+std::string ShiftedShape(const mbslam::eval::ReconstructionResult& r) {
+  if (!r.shape_translated) return "(not fitted: fewer than 4 points)";
+  char buf[128];
+  std::snprintf(buf, sizeof(buf), "%.2f %% (median %.2f %%; shifted %.3f m)", 100.0 * r.shape_translated_err_rel,
+                100.0 * r.shape_translated_err_rel_median, r.translation_fit_m);
+  return buf;
+}
+
 int RunReconstructions(const mbslam::CommandLineArgs& args) {
   const int min_samples = static_cast<int>(args.GetInt("min-samples", 10));
   const int64_t max_dt = args.GetInt("max-dt-us", 20000);
@@ -642,13 +651,11 @@ int RunReconstructions(const mbslam::CommandLineArgs& args) {
     std::printf(
         "  object %d map %lld -> body %d (%s): %d images, trajectory %.3f m = %.2f %% of the %.2f m path "
         "(%.2f %% of the %.2f m range); %d points, shape rmse %.3f m = %.2f %% of the %.2f m size (median "
-        "%.2f %%, %.0f %% within 2 %%); after the points' rigid fit %.2f %% (median %.2f %%; moved %.2f deg, "
-        "%.3f m)\n",
+        "%.2f %%, %.0f %% within 2 %%); shifted onto the box %s\n",
         r.object_id, static_cast<long long>(r.map_id), r.gt_id, r.gt_name.c_str(), r.samples, r.trajectory_rmse_m,
         100.0 * r.trajectory_err_rel_path, r.path_length_m, 100.0 * r.trajectory_err_rel_range, r.mean_range_m,
         r.num_points, r.shape_rmse_m, 100.0 * r.shape_err_rel, r.size_m, 100.0 * r.shape_err_rel_median,
-        100.0 * r.share_within_2pct, 100.0 * r.shape_rigid_err_rel, 100.0 * r.shape_rigid_err_rel_median,
-        r.rigid_fit_rotation_deg, r.rigid_fit_translation_m);
+        100.0 * r.share_within_2pct, ShiftedShape(r).c_str());
     Json o = Json::Object();
     o.Set("object_id", r.object_id).Set("map_id", static_cast<int64_t>(r.map_id)).Set("gt_id", r.gt_id);
     o.Set("name", r.gt_name).Set("samples", r.samples).Set("scale", r.scale);
@@ -657,8 +664,10 @@ int RunReconstructions(const mbslam::CommandLineArgs& args) {
     o.Set("trajectory_err_rel_range", r.trajectory_err_rel_range).Set("points", r.num_points);
     o.Set("shape_rmse_m", r.shape_rmse_m).Set("shape_err_rel", r.shape_err_rel);
     o.Set("shape_err_rel_median", r.shape_err_rel_median).Set("share_within_2pct", r.share_within_2pct);
-    o.Set("shape_rigid_err_rel", r.shape_rigid_err_rel).Set("shape_rigid_err_rel_median", r.shape_rigid_err_rel_median);
-    o.Set("rigid_fit_rotation_deg", r.rigid_fit_rotation_deg).Set("rigid_fit_translation_m", r.rigid_fit_translation_m);
+    o.Set("shape_translated_rmse_m", r.shape_translated ? Json(r.shape_translated_rmse_m) : Json())
+        .Set("shape_translated_err_rel", r.shape_translated ? Json(r.shape_translated_err_rel) : Json())
+        .Set("shape_translated_err_rel_median", r.shape_translated ? Json(r.shape_translated_err_rel_median) : Json())
+        .Set("translation_fit_m", r.shape_translated ? Json(r.translation_fit_m) : Json());
     list.Push(o);
     if (!longest || r.samples > longest->samples) longest = &r;
   }
@@ -669,15 +678,17 @@ int RunReconstructions(const mbslam::CommandLineArgs& args) {
     // The headline is the longest-lived reconstruction (not the best one).
     std::printf(
         "longest: object %d map %lld (%s), %d images: trajectory %.2f %% of path, shape %.2f %% of size (%.2f %% "
-        "after the points' rigid fit)\n",
+        "shifted onto the box)\n",
         longest->object_id, static_cast<long long>(longest->map_id), longest->gt_name.c_str(), longest->samples,
-        100.0 * longest->trajectory_err_rel_path, 100.0 * longest->shape_err_rel, 100.0 * longest->shape_rigid_err_rel);
+        100.0 * longest->trajectory_err_rel_path, 100.0 * longest->shape_err_rel,
+        longest->shape_translated ? 100.0 * longest->shape_translated_err_rel : NAN);
     j.Set("object_traj_err_rel", longest->trajectory_err_rel_path)
         .Set("object_traj_err_rel_range", longest->trajectory_err_rel_range)
         .Set("object_shape_err_rel", longest->shape_err_rel)
         .Set("object_shape_err_rel_median", longest->shape_err_rel_median)
-        .Set("object_shape_rigid_err_rel", longest->shape_rigid_err_rel)
-        .Set("object_shape_rigid_err_rel_median", longest->shape_rigid_err_rel_median)
+        .Set("object_shape_translated_err_rel", longest->shape_translated ? Json(longest->shape_translated_err_rel) : Json())
+        .Set("object_shape_translated_err_rel_median",
+             longest->shape_translated ? Json(longest->shape_translated_err_rel_median) : Json())
         .Set("object_reconstruction_images", longest->samples)
         .Set("object_reconstruction_body", longest->gt_name);
   }
@@ -896,9 +907,11 @@ void Usage() {
            --est-log LOG --gt-log LOG [--horizon-us N] [--align sim3|se3] [--max-match-m M] [--settle-us N]
            [--dump FILE.csv: per matched sample, truth and estimate in the true camera frame]
   reconstructions  moving objects' own reconstructions (result/reconstructions/): camera-relative
-           trajectory and shape (point-to-box distance) after a similarity, per body
+           trajectory and shape (point-to-box distance) after a similarity, per body, and the shape
+           again after the points' own shift onto the box (4 points at least)
            --dir DIR --gt-log LOG [--min-samples 10] [--max-dt-us N]
-           (env EVAL_DUMP_SHAPE set, to any value: each scored point in its body's frame and its distance, to stderr)
+           (env EVAL_DUMP_SHAPE set, to any value: each scored point in its body's frame and its distance,
+           unshifted and shifted, to stderr)
   points   reconstruction accuracy / completeness against ground-truth surface points
            --est XYZ --gt XYZ (e.g. <sequence>/points/<id>.txt) [--threshold 0.05] [--max-distance 1.0]
   perturb  write a trajectory with a known similarity and noise (expected ATE printed)

@@ -43,59 +43,40 @@ double BoxSignedDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent
   return outside > 0.0 ? outside : q.maxCoeff();
 }
 
-Rigid3d FitPointsToBoxSurface(const Eigen::Vector3d& extent, std::vector<Eigen::Vector3d>* points) {
-  Rigid3d moved;  // identity
-  // Six points or fewer can be put on almost any surface by the six parameters.
-  if (points->size() < 7) return moved;
-  const auto cost_of = [&](const std::vector<Eigen::Vector3d>& pts) {
+Eigen::Vector3d FitTranslationToBoxSurface(const Eigen::Vector3d& extent, std::vector<Eigen::Vector3d>* points) {
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  if (points->size() < 4) return shift;
+  const auto cost_of = [&](const Eigen::Vector3d& v) {
     double c = 0.0;
-    for (const Eigen::Vector3d& p : pts) c += std::pow(BoxSignedDistance(p, extent), 2);
+    for (const Eigen::Vector3d& p : *points) c += std::pow(BoxSignedDistance(p + v, extent), 2);
     return c;
   };
-  // A left perturbation q -> q + v + w x q about the points' centroid, which keeps the
-  // rotation and translation directions well conditioned.
-  double cost = cost_of(*points);
+  double cost = cost_of(shift);
   double lambda = 1e-3;
   const double h = 1e-6 * std::max(1.0, extent.maxCoeff());
   for (int iter = 0; iter < 100; ++iter) {
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& p : *points) c += p;
-    c /= static_cast<double>(points->size());
-    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    for (const Eigen::Vector3d& p : *points) {
-      const double r = BoxSignedDistance(p, extent);
-      Eigen::Vector3d grad;
+    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& p0 : *points) {
+      const Eigen::Vector3d p = p0 + shift;
+      Eigen::Vector3d grad;  // of the signed distance, by central differences
       for (int k = 0; k < 3; ++k) {
         Eigen::Vector3d dp = Eigen::Vector3d::Zero();
         dp[k] = h;
         grad[k] = (BoxSignedDistance(p + dp, extent) - BoxSignedDistance(p - dp, extent)) / (2.0 * h);
       }
-      Eigen::Matrix<double, 1, 6> J;
-      J.head<3>() = grad.transpose();
-      J.tail<3>() = (p - c).cross(grad).transpose();  // d/dw of grad . (w x (p - c))
-      H += J.transpose() * J;
-      g += J.transpose() * r;
+      H += grad * grad.transpose();
+      g += grad * BoxSignedDistance(p, extent);
     }
     bool improved = false;
     while (lambda < 1e8) {
-      Eigen::Matrix<double, 6, 6> A = H;
+      Eigen::Matrix3d A = H;
       A.diagonal() += lambda * (H.diagonal().array() + 1e-9).matrix();
-      const Eigen::Matrix<double, 6, 1> delta = -A.ldlt().solve(g);
+      const Eigen::Vector3d delta = -A.ldlt().solve(g);
       if (!delta.allFinite()) break;
-      const Eigen::Vector3d w = delta.tail<3>();
-      const double angle = w.norm();
-      const Eigen::Quaterniond dq =
-          angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle)) : Eigen::Quaterniond::Identity();
-      // x -> dq (x - c) + c + v
-      const Rigid3d step(dq, c + delta.head<3>() - dq * c);
-      std::vector<Eigen::Vector3d> trial;
-      trial.reserve(points->size());
-      for (const Eigen::Vector3d& p : *points) trial.push_back(step * p);
-      const double trial_cost = cost_of(trial);
+      const double trial_cost = cost_of(shift + delta);
       if (trial_cost < cost) {
-        *points = std::move(trial);
-        moved = step * moved;
+        shift += delta;
         improved = cost - trial_cost > 1e-12 * std::max(cost, 1e-12);
         cost = trial_cost;
         lambda = std::max(1e-6, lambda * 0.3);
@@ -105,7 +86,8 @@ Rigid3d FitPointsToBoxSurface(const Eigen::Vector3d& extent, std::vector<Eigen::
     }
     if (!improved) break;
   }
-  return moved;
+  for (Eigen::Vector3d& p : *points) p += shift;
+  return shift;
 }
 
 Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<int, BodyTruth>& truth,
@@ -114,6 +96,7 @@ Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<
   bool found = false;
   double best = std::numeric_limits<double>::infinity();
   std::vector<Eigen::Vector3d> best_points;  // the best body's frame
+  Eigen::Vector3d best_shift = Eigen::Vector3d::Zero();
   for (const auto& [id, body] : truth) {
     std::vector<Rigid3d> src, dst;
     for (const TimedPose& e : est.obj_from_cam) {
@@ -168,29 +151,26 @@ Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<
       r.shape_err_rel_median = r.shape_median_m / r.size_m;
     }
     r.share_within_2pct = d.empty() ? 0.0 : static_cast<double>(within) / static_cast<double>(d.size());
-    std::vector<Eigen::Vector3d> fitted = best_points;
-    const Rigid3d fit = FitPointsToBoxSurface(body.extent, &fitted);
-    std::vector<double> d_rigid;
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (size_t i = 0; i < fitted.size(); ++i) {
-      d_rigid.push_back(BoxSurfaceDistance(fitted[i], body.extent));
-      centroid += best_points[i];
-    }
-    if (!fitted.empty()) centroid /= static_cast<double>(fitted.size());
-    r.shape_rigid_rmse_m = Rms(d_rigid);
+    std::vector<Eigen::Vector3d> shifted = best_points;
+    const Eigen::Vector3d shift = FitTranslationToBoxSurface(body.extent, &shifted);
+    r.shape_translated = shifted.size() >= 4;
+    std::vector<double> d_shifted;
+    for (const Eigen::Vector3d& q : shifted) d_shifted.push_back(BoxSurfaceDistance(q, body.extent));
+    r.shape_translated_rmse_m = Rms(d_shifted);
     if (r.size_m > 0.0) {
-      r.shape_rigid_err_rel = r.shape_rigid_rmse_m / r.size_m;
-      r.shape_rigid_err_rel_median = Median(d_rigid) / r.size_m;
+      r.shape_translated_err_rel = r.shape_translated_rmse_m / r.size_m;
+      r.shape_translated_err_rel_median = Median(d_shifted) / r.size_m;
     }
-    r.rigid_fit_rotation_deg = Eigen::AngleAxisd(fit.rotation).angle() * 180.0 / M_PI;
-    r.rigid_fit_translation_m = (fit * centroid - centroid).norm();
+    r.translation_fit_m = shift.norm();
+    best_shift = shift;
   }
   if (found && std::getenv("EVAL_DUMP_SHAPE")) {
     // Each scored point in the body's frame with its distance to the body's surface.
     for (const Eigen::Vector3d& q : best_points) {
-      std::fprintf(stderr, "SHAPE object %d map %lld body %d point %.3f %.3f %.3f distance %.3f\n", result->object_id,
-                   static_cast<long long>(result->map_id), result->gt_id, q.x(), q.y(), q.z(),
-                   BoxSurfaceDistance(q, truth.at(result->gt_id).extent));
+      std::fprintf(stderr, "SHAPE object %d map %lld body %d point %.3f %.3f %.3f distance %.3f (%.3f shifted)\n",
+                   result->object_id, static_cast<long long>(result->map_id), result->gt_id, q.x(), q.y(), q.z(),
+                   BoxSurfaceDistance(q, truth.at(result->gt_id).extent),
+                   BoxSurfaceDistance(q + best_shift, truth.at(result->gt_id).extent));
     }
   }
   if (!found) return Status::Error("reconstruction of object " + std::to_string(est.object_id) + " map " +

@@ -10,12 +10,14 @@
 //   shape: the object's points through that similarity, distance to the surface of the
 //     body's true box (origin at its centre, extent along body x y z), over its size
 //     (the largest extent);
-//   shape after a rigid fit: the same points, moved by the rotation and translation
-//     (scale kept) that bring them closest to that surface. The trajectory's similarity
-//     carries its own error onto the points through a lever arm: an error of a tenth of a
-//     degree in the orientations that fix its rotation moves the points, 6-7 m from the
-//     camera path, by about a centimetre, which is not an error of the shape itself. The
-//     scale stays the trajectory's: with a free scale the points would shrink onto one face.
+//   shape after a translation: the same points, shifted by the translation that brings
+//     them closest to that surface. The trajectory's similarity carries its own error
+//     onto the points through a lever arm: an error of a tenth of a degree in the
+//     orientations that fix its rotation shifts the points, 6-7 m from the camera path,
+//     by about a centimetre, while it turns them by only that tenth of a degree. Only the
+//     shift is refitted, so that the fit cannot absorb the shape's own errors (a
+//     rotation about a face's normal or a tilt); the scale stays the trajectory's (with a
+//     free scale the points would shrink onto one face).
 // Each reconstruction is matched to the body it fits best.
 
 #include <map>
@@ -57,12 +59,13 @@ struct ReconstructionResult {
   double shape_err_rel = 0.0;         // shape_rmse_m / size_m
   double shape_err_rel_median = 0.0;  // shape_median_m / size_m
   double share_within_2pct = 0.0;     // points within 2 % of the size of the surface
-  // After the rigid fit of the points to the surface (scale kept).
-  double shape_rigid_rmse_m = 0.0;
-  double shape_rigid_err_rel = 0.0;          // shape_rigid_rmse_m / size_m
-  double shape_rigid_err_rel_median = 0.0;
-  double rigid_fit_rotation_deg = 0.0;       // how far the fit moved the points: rotation
-  double rigid_fit_translation_m = 0.0;      // ... and translation at their centroid
+  // After the points' own translation to the surface (scale and rotation kept); not
+  // fitted (the fields repeat the unfitted figures) with fewer than 4 points.
+  bool shape_translated = false;
+  double shape_translated_rmse_m = 0.0;
+  double shape_translated_err_rel = 0.0;         // shape_translated_rmse_m / size_m
+  double shape_translated_err_rel_median = 0.0;
+  double translation_fit_m = 0.0;                // length of that translation
 };
 
 // Distance of p to the surface of the box of full size `extent` centred at the origin.
@@ -71,11 +74,11 @@ double BoxSurfaceDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& exten
 // Signed distance of p to the surface of that box: negative inside.
 double BoxSignedDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent);
 
-// The rigid motion (applied in the box's frame) that brings `points` closest to the
-// surface of the box of full size `extent` centred at the origin, in the least-squares
-// sense (Levenberg-Marquardt from the identity); the points are replaced by the moved ones.
-// Fewer than 7 points are left as they are (six parameters fit almost any six points).
-Rigid3d FitPointsToBoxSurface(const Eigen::Vector3d& extent, std::vector<Eigen::Vector3d>* points);
+// The translation (in the box's frame) that brings `points` closest to the surface of
+// the box of full size `extent` centred at the origin, in the least-squares sense
+// (Levenberg-Marquardt from zero); the points are shifted by it. Fewer than 4 points
+// (three parameters fit any three) are left as they are, and zero is returned.
+Eigen::Vector3d FitTranslationToBoxSurface(const Eigen::Vector3d& extent, std::vector<Eigen::Vector3d>* points);
 
 // Matches `est` to the body of `truth` whose true camera-relative trajectory it fits best
 // (lowest trajectory error over the mean range); needs >= min_samples common images.

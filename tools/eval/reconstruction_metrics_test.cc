@@ -61,7 +61,8 @@ TEST(ReconstructionMetricsTest, ExactReconstructionThroughASimilarityScoresZero)
   est.points = {map_from_body * Eigen::Vector3d(2.52, 0.0, 0.0)};
   ASSERT_TRUE(EvaluateReconstruction(est, truth, cam, 20000, 10, &r).ok());
   EXPECT_NEAR(r.shape_err_rel, 0.1, 1e-6);
-  EXPECT_NEAR(r.shape_rigid_err_rel, 0.1, 1e-6) << "too few points to fit (six or fewer fit any surface)";
+  EXPECT_FALSE(r.shape_translated) << "one point: not fitted (a shift puts up to three on any surface)";
+  EXPECT_NEAR(r.shape_translated_err_rel, 0.1, 1e-6);
   // Too few common images: refused.
   est.obj_from_cam.resize(5);
   EXPECT_FALSE(EvaluateReconstruction(est, truth, cam, 20000, 10, &r).ok());
@@ -74,9 +75,9 @@ TEST(ReconstructionMetricsTest, BoxSignedDistanceIsNegativeInside) {
   EXPECT_NEAR(BoxSignedDistance(Eigen::Vector3d(1.5, 0.0, 0.0), e), -0.5, 1e-12);
 }
 
-// Points on three faces of a box, displaced by a small rigid motion: the fit brings them
-// back onto the surface; points that are not on the surface in any pose (a bump) stay off.
-TEST(ReconstructionMetricsTest, RigidFitUndoesADisplacementButNotAShapeError) {
+// Points on three faces of a box, shifted: the fit shifts them back onto the surface by
+// the opposite translation; a bump or a turn (which a shift cannot undo) stays.
+TEST(ReconstructionMetricsTest, TranslationFitUndoesAShiftButNotAShapeError) {
   const Eigen::Vector3d e(0.5, 0.6, 1.8);
   std::vector<Eigen::Vector3d> surface;
   for (int i = -2; i <= 2; ++i) {
@@ -86,25 +87,34 @@ TEST(ReconstructionMetricsTest, RigidFitUndoesADisplacementButNotAShapeError) {
     }
     surface.emplace_back(0.1 * i, 0.1 * i, 0.9);       // top face
   }
-  const Rigid3d offset(Eigen::Quaterniond(Eigen::AngleAxisd(0.03, Eigen::Vector3d(1, -2, 0.5).normalized())),
-                       Eigen::Vector3d(0.03, -0.02, 0.04));
+  const Eigen::Vector3d offset(0.03, -0.02, 0.04);
   std::vector<Eigen::Vector3d> pts;
-  double before = 0.0;
-  for (const Eigen::Vector3d& p : surface) {
-    pts.push_back(offset * p);
-    before = std::max(before, BoxSurfaceDistance(pts.back(), e));
+  for (const Eigen::Vector3d& p : surface) pts.push_back(p + offset);
+  const Eigen::Vector3d shift = FitTranslationToBoxSurface(e, &pts);
+  EXPECT_LT((shift + offset).norm(), 1e-4);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    EXPECT_LT(BoxSurfaceDistance(pts[i], e), 1e-4);
+    EXPECT_LT((pts[i] - (surface[i] + offset + shift)).norm(), 1e-12) << "the points moved by the returned shift";
   }
-  ASSERT_GT(before, 0.03);
-  const Rigid3d fit = FitPointsToBoxSurface(e, &pts);
-  for (const Eigen::Vector3d& p : pts) EXPECT_LT(BoxSurfaceDistance(p, e), 1e-4);
-  EXPECT_GT(Eigen::AngleAxisd(fit.rotation).angle(), 0.02);
-  // A bump of 0.1 m on the front face is a shape error no rigid motion removes.
+  const auto rms = [&](const std::vector<Eigen::Vector3d>& q) {
+    double sum2 = 0.0;
+    for (const Eigen::Vector3d& p : q) sum2 += std::pow(BoxSurfaceDistance(p, e), 2);
+    return std::sqrt(sum2 / static_cast<double>(q.size()));
+  };
+  // A bump of 0.1 m on six points of the front face is a shape error no shift removes.
   std::vector<Eigen::Vector3d> bumped = surface;
   for (int k = 0; k < 6; ++k) bumped[2 * k] += Eigen::Vector3d(0.1, 0.0, 0.0);
-  FitPointsToBoxSurface(e, &bumped);
-  double sum2 = 0.0;
-  for (const Eigen::Vector3d& p : bumped) sum2 += std::pow(BoxSurfaceDistance(p, e), 2);
-  EXPECT_GT(std::sqrt(sum2 / static_cast<double>(bumped.size())), 0.01);
+  FitTranslationToBoxSurface(e, &bumped);
+  EXPECT_GT(rms(bumped), 0.01);
+  // Nor a turn of 3 deg about the vertical axis (it moves the far points by 5 cm).
+  std::vector<Eigen::Vector3d> turned;
+  const Eigen::AngleAxisd turn(3.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ());
+  for (const Eigen::Vector3d& p : surface) turned.push_back(turn * p);
+  FitTranslationToBoxSurface(e, &turned);
+  EXPECT_GT(rms(turned), 0.005);
+  // Three points are not fitted.
+  std::vector<Eigen::Vector3d> three = {pts[0] + offset, pts[1] + offset, pts[2] + offset};
+  EXPECT_EQ(FitTranslationToBoxSurface(e, &three), Eigen::Vector3d::Zero());
 }
 
 }  // namespace
