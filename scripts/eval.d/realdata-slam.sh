@@ -151,14 +151,16 @@ for key in ("tracked_fraction", "tracked_fraction_live", "posed_fraction", "ate_
             "static_false_moving_fraction", "static_frames_with_moving_share", "static_phantom_objects"):
     vals = [v[key] for v in runs.values() if v.get(key) is not None]
     out[key + "_mean"] = statistics.mean(vals) if vals else None
+def fmt(x, scale, spec, unit):
+    return "n/a" if x is None else f"{scale * x:{spec}}{unit}"
 vals = [v["ate_rel_path"] for v in runs.values() if v.get("ate_rel_path") is not None]
 out["ate_rel_path_median"] = statistics.median(vals) if vals else None
 print(f"{name} over starts {sorted(runs)}: tracked (trajectory file) {100 * out['tracked_fraction_mean']:.1f} %, live poses "
       f"{100 * out['tracked_fraction_live_mean']:.1f} %, ATE mean {100 * out['ate_rel_path_mean']:.2f} % "
       f"(median {100 * out['ate_rel_path_median']:.2f} %) of the path; static scene: "
-      f"{100 * (out['static_false_moving_fraction_mean'] or 0):.1f} % of the features labelled moving, in "
-      f"{100 * (out['static_frames_with_moving_share_mean'] or 0):.0f} % of the images, "
-      f"{out['static_phantom_objects_mean'] or 0:.1f} phantom objects (means)", file=sys.stderr)
+      f"{fmt(out['static_false_moving_fraction_mean'], 100, '.1f', ' %')} of the features labelled moving, in "
+      f"{fmt(out['static_frames_with_moving_share_mean'], 100, '.0f', ' %')} of the images, "
+      f"{fmt(out['static_phantom_objects_mean'], 1, '.1f', '')} phantom objects (means)", file=sys.stderr)
 print(json.dumps({name: out}))
 PY
 )")

@@ -290,14 +290,14 @@ int RotationGivenHeading(const std::vector<Eigen::Vector2d>& x_r, const std::vec
     *c = a.dot(b);
     *g = -(Hat(b).transpose() * a);  // a' (w x b) = a' (-[b]x w)
   };
-  // Inliers of R; stops early (returning at most `to_beat`) once the rest cannot make
-  // more than `to_beat`: only a larger count is kept, so the result is the same.
+  // Inliers of R; stops early (returning a count of at most `to_beat`) once the rest
+  // cannot make more than `to_beat`: only a larger count is kept, so the result is the same.
   auto count = [&](const Eigen::Matrix3d& R, int to_beat) {
     const Eigen::Matrix3d E = Tx * R;
     int k = 0;
     for (size_t i = 0; i < n; ++i) {
       k += std::abs(EpipolarDistance(E, x_r[i], x_n[i])) <= thresh;
-      if (k + static_cast<int>(n - 1 - i) <= to_beat) return std::min(k, to_beat);
+      if (k + static_cast<int>(n - 1 - i) <= to_beat) return k;
     }
     return k;
   };

@@ -388,8 +388,13 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
       }
     }
   };
+  // Images far apart in time (tracking.wide_baseline_min_interval_us): most tracks lost
+  // is what such a baseline does, not a glitch.
+  const bool wide_baseline =
+      options_.wide_baseline_min_interval_us > 0 && hints.interval_us >= options_.wide_baseline_min_interval_us;
   auto is_glitch = [&]() {
-    return options_.glitch_max_survival > 0.0 && !last_rejected_ && stats_.established >= options_.glitch_min_tracks &&
+    return options_.glitch_max_survival > 0.0 && !wide_baseline && !last_rejected_ &&
+           stats_.established >= options_.glitch_min_tracks &&
            static_cast<double>(stats_.established_matched) <
                options_.glitch_max_survival * static_cast<double>(stats_.established);
   };
@@ -544,8 +549,6 @@ void FeatureTracker::TrackFrame(const std::vector<cv::Mat>& pyramid, int64_t fra
   // Wide baseline: when KLT kept too few, ORB descriptors re-match the lost tracks.
   if (options_.descriptor_fallback && !prev_pts.empty() &&
       static_cast<double>(stats_.tracked) < options_.fallback_survival * static_cast<double>(prev_pts.size())) {
-    const bool wide_baseline = options_.wide_baseline_min_interval_us > 0 &&
-                               hints.interval_us >= options_.wide_baseline_min_interval_us;
     MatchByDescriptors(prev_pyramid_[0], image, frame_index, wide_baseline, &recently_lost_, &next_tracks);
   }
 

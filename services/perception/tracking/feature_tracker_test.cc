@@ -665,30 +665,37 @@ TEST(FeatureTracker, DescriptorFallbackRefindsTracksAcrossATurn) {
 namespace mbslam {
 namespace {
 
-// Two images 120 px apart (a low frame rate): KLT loses the tracks. Taken 33 ms apart,
-// the usual fallback re-finds few (its lost tracks' descriptors are single-level and
-// unoriented, the new keypoints' are not); taken 500 ms apart they are a wide baseline
-// (tracking.wide_baseline_min_interval_us) and both sides are described alike.
+// A view tracked over four images (2 px apart), then one 120 px away (a low frame rate):
+// KLT loses the tracks. Taken 33 ms after the last, the image is rejected as a glitch
+// (nearly every established track lost at once); taken 500 ms after it, it is a wide
+// baseline (tracking.wide_baseline_min_interval_us): not a glitch, and the fallback
+// describes both sides alike and re-finds the tracks.
 struct WideRun {
+  bool rejected = false;
   int matched = 0;  // re-found by descriptors
-  int good = 0;     // ... of them within 2 px of the truth
+  int good = 0;     // tracks seen in the last image within 2 px of the truth
 };
-WideRun RunShifted(int64_t interval_us) {
+WideRun RunShifted(int64_t interval_us, bool fallback = true) {
   TrackerOptions o;
+  o.descriptor_fallback = fallback;
   FeatureTracker tracker(o);
   const cv::Mat base = testing_images::Texture(640, 480, 4);
-  tracker.TrackFrame(Pyramid(base), 0, {});
+  for (int f = 0; f < 4; ++f) {
+    TrackingHints hints;
+    hints.interval_us = 33333;
+    tracker.TrackFrame(Pyramid(Shift(base, 2.0f * f, 0.0f)), f, hints);
+  }
   std::map<int64_t, Eigen::Vector2f> start;
   for (const Track& t : tracker.tracks()) start[t.id] = t.uv;
-  const cv::Mat moved = Shift(base, 120.0, 40.0);
   TrackingHints hints;
   hints.interval_us = interval_us;
-  tracker.TrackFrame(Pyramid(moved), 1, hints);
+  tracker.TrackFrame(Pyramid(Shift(base, 6.0f + 120.0f, 40.0f)), 4, hints);
   WideRun run;
+  run.rejected = tracker.stats().rejected;
   run.matched = tracker.stats().descriptor_matched;
   for (const Track& t : tracker.tracks()) {
     auto it = start.find(t.id);
-    if (it == start.end() || t.last_seen_frame != 1) continue;
+    if (it == start.end() || t.last_seen_frame != 4) continue;
     run.good += (t.uv - it->second - Eigen::Vector2f(120.0f, 40.0f)).norm() <= 2.0f;
   }
   return run;
@@ -697,10 +704,29 @@ WideRun RunShifted(int64_t interval_us) {
 TEST(FeatureTracker, WideBaselineFallbackDescribesBothSidesAlike) {
   const WideRun video = RunShifted(33333);
   const WideRun wide = RunShifted(500000);
-  std::cout << "120 px apart: 33 ms " << video.matched << " re-found (" << video.good << " within 2 px), 500 ms "
-            << wide.matched << " (" << wide.good << ")\n";
-  EXPECT_GT(wide.good, 3 * std::max(video.good, 10));
-  EXPECT_GT(wide.good, 0.8 * wide.matched);
+  const WideRun klt_only = RunShifted(500000, /*fallback=*/false);
+  std::cout << "120 px apart: 33 ms " << (video.rejected ? "rejected" : "taken") << ", " << video.matched
+            << " re-found; 500 ms " << (wide.rejected ? "rejected" : "taken") << ", " << wide.matched << " re-found, "
+            << wide.good << " tracks within 2 px (" << klt_only.good << " without the fallback)\n";
+  EXPECT_TRUE(video.rejected);
+  EXPECT_FALSE(wide.rejected);
+  EXPECT_LT(klt_only.good, 20);
+  // The tracks within 2 px are the fallback's (KLT keeps few), and nearly all it re-found.
+  EXPECT_GT(wide.good - klt_only.good, 200);
+  EXPECT_GT(wide.good - klt_only.good, 0.8 * wide.matched);
+}
+
+// The same jump with a glitch test off: at video rate the usual fallback re-finds few.
+TEST(FeatureTracker, AtVideoRateTheUsualFallbackRefindsFew) {
+  TrackerOptions o;
+  o.glitch_max_survival = 0.0;
+  FeatureTracker tracker(o);
+  const cv::Mat base = testing_images::Texture(640, 480, 4);
+  TrackingHints hints;
+  hints.interval_us = 33333;
+  tracker.TrackFrame(Pyramid(base), 0, hints);
+  tracker.TrackFrame(Pyramid(Shift(base, 120.0f, 40.0f)), 1, hints);
+  EXPECT_LT(tracker.stats().descriptor_matched, 50);
 }
 
 }  // namespace
