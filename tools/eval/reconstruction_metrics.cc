@@ -30,22 +30,19 @@ double Rms(const std::vector<double>& v) {
 
 }  // namespace
 
-double BoxSurfaceDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent) {
-  const Eigen::Vector3d q = p.cwiseAbs() - 0.5 * extent;
-  const double outside = q.cwiseMax(0.0).norm();
-  const double inside = std::min(q.maxCoeff(), 0.0);
-  return outside > 0.0 ? outside : -inside;
-}
-
 double BoxSignedDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent) {
   const Eigen::Vector3d q = p.cwiseAbs() - 0.5 * extent;
   const double outside = q.cwiseMax(0.0).norm();
   return outside > 0.0 ? outside : q.maxCoeff();
 }
 
+double BoxSurfaceDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent) {
+  return std::abs(BoxSignedDistance(p, extent));
+}
+
 Eigen::Vector3d FitTranslationToBoxSurface(const Eigen::Vector3d& extent, std::vector<Eigen::Vector3d>* points) {
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();
-  if (points->size() < 4) return shift;
+  if (points->size() < kMinShiftedPoints) return shift;
   const auto cost_of = [&](const Eigen::Vector3d& v) {
     double c = 0.0;
     for (const Eigen::Vector3d& p : *points) c += std::pow(BoxSignedDistance(p + v, extent), 2);
@@ -153,7 +150,7 @@ Status EvaluateReconstruction(const ReconstructionEstimate& est, const std::map<
     r.share_within_2pct = d.empty() ? 0.0 : static_cast<double>(within) / static_cast<double>(d.size());
     std::vector<Eigen::Vector3d> shifted = best_points;
     const Eigen::Vector3d shift = FitTranslationToBoxSurface(body.extent, &shifted);
-    r.shape_translated = shifted.size() >= 4;
+    r.shape_translated = shifted.size() >= kMinShiftedPoints;
     std::vector<double> d_shifted;
     for (const Eigen::Vector3d& q : shifted) d_shifted.push_back(BoxSurfaceDistance(q, body.extent));
     r.shape_translated_rmse_m = Rms(d_shifted);

@@ -20,6 +20,7 @@
 //     free scale the points would shrink onto one face).
 // Each reconstruction is matched to the body it fits best.
 
+#include <cstddef>
 #include <map>
 #include <string>
 #include <vector>
@@ -74,10 +75,13 @@ double BoxSurfaceDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& exten
 // Signed distance of p to the surface of that box: negative inside.
 double BoxSignedDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& extent);
 
+// Fewer points than this are not shifted (three parameters fit any three).
+inline constexpr size_t kMinShiftedPoints = 4;
+
 // The translation (in the box's frame) that brings `points` closest to the surface of
 // the box of full size `extent` centred at the origin, in the least-squares sense
-// (Levenberg-Marquardt from zero); the points are shifted by it. Fewer than 4 points
-// (three parameters fit any three) are left as they are, and zero is returned.
+// (Levenberg-Marquardt from zero); the points are shifted by it. Fewer than
+// kMinShiftedPoints are left as they are, and zero is returned.
 Eigen::Vector3d FitTranslationToBoxSurface(const Eigen::Vector3d& extent, std::vector<Eigen::Vector3d>* points);
 
 // Matches `est` to the body of `truth` whose true camera-relative trajectory it fits best
