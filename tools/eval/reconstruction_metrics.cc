@@ -8,18 +8,13 @@
 #include <cstdlib>
 #include <limits>
 
+#include "common/util/statistics.h"
 #include "tools/eval/alignment.h"
 #include "tools/eval/point_metrics.h"
 
 namespace mbslam {
 namespace eval {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 double Rms(const std::vector<double>& v) {
   if (v.empty()) return 0.0;
