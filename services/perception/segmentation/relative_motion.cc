@@ -9,6 +9,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "common/util/logging.h"
+#include "services/perception/geometry/essential.h"
 
 namespace mbslam {
 
@@ -416,8 +417,23 @@ Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
   if (median_parallax < options.min_parallax_px) return rotation_only();
 
   cv::Mat mask;
-  cv::Mat E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC,
-                                   options.ransac_confidence, thresh, options.ransac_max_iterations, mask);
+  cv::Mat E;
+  if (options.essential_backend == "opencv") {
+    E = cv::findEssentialMat(pr, pn, 1.0, cv::Point2d(0, 0), cv::RANSAC, options.ransac_confidence, thresh,
+                             options.ransac_max_iterations, mask);
+  } else {
+    EssentialRansacOptions ro;
+    ro.threshold = thresh;
+    ro.confidence = options.ransac_confidence;
+    ro.max_iterations = options.ransac_max_iterations;
+    ro.min_iterations = options.ransac_min_iterations;
+    ro.msac = options.ransac_msac;
+    EssentialRansacResult rr;
+    if (EstimateEssentialRansac(x_r, x_n, ro, &rr).ok()) {
+      cv::eigen2cv(rr.E, E);
+      mask = cv::Mat(static_cast<int>(n), 1, CV_8U, rr.inliers.data()).clone();
+    }
+  }
   if (E.empty() || E.rows != 3) return Status::Error("essential matrix RANSAC failed");
   Eigen::Matrix3d Re;
   Eigen::Vector3d te;

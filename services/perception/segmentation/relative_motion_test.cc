@@ -60,18 +60,24 @@ TEST(RelativeMotion, RecoversDirectionAndRotation) {
   MakeScene(truth, 200, 0.5 / 500.0, &rng, &xr, &xn);
   // 20% outliers.
   for (int i = 0; i < 40; ++i) xn[static_cast<size_t>(i)] += Eigen::Vector2d(0.03, -0.02);
-  RelativeMotion m;
-  std::vector<uint8_t> inliers;
-  ASSERT_TRUE(EstimateRelativeMotion(xr, xn, 500.0, TwoViewOptions(), &m, &inliers).ok());
-  EXPECT_TRUE(m.translation_known);
-  EXPECT_LT(RotationDistance(m.cam_n_from_cam_r, truth), 2e-3);
-  EXPECT_GT(m.cam_n_from_cam_r.translation.dot(truth.translation.normalized()), 0.995);
-  int outliers_flagged = 0;
-  for (int i = 0; i < 40; ++i) outliers_flagged += !inliers[static_cast<size_t>(i)];
-  EXPECT_GE(outliers_flagged, 38);
-  // The covariance is positive and small on the observable directions.
-  EXPECT_GT(m.covariance.trace(), 0.0);
-  EXPECT_LT(m.covariance.trace(), 1e-2);
+  // Both essential matrix backends.
+  for (const char* backend : {"mbslam", "opencv"}) {
+    SCOPED_TRACE(backend);
+    TwoViewOptions options;
+    options.essential_backend = backend;
+    RelativeMotion m;
+    std::vector<uint8_t> inliers;
+    ASSERT_TRUE(EstimateRelativeMotion(xr, xn, 500.0, options, &m, &inliers).ok());
+    EXPECT_TRUE(m.translation_known);
+    EXPECT_LT(RotationDistance(m.cam_n_from_cam_r, truth), 2e-3);
+    EXPECT_GT(m.cam_n_from_cam_r.translation.dot(truth.translation.normalized()), 0.995);
+    int outliers_flagged = 0;
+    for (int i = 0; i < 40; ++i) outliers_flagged += !inliers[static_cast<size_t>(i)];
+    EXPECT_GE(outliers_flagged, 38);
+    // The covariance is positive and small on the observable directions.
+    EXPECT_GT(m.covariance.trace(), 0.0);
+    EXPECT_LT(m.covariance.trace(), 1e-2);
+  }
 }
 
 // A pan with a small sideways step over a near layer (rocks) below a far one (a hillside),
