@@ -224,7 +224,7 @@ Status EstimateEssentialRansac(const std::vector<Eigen::Vector2d>& x_r, const st
         for (int i = 0; i < n && cost < best_cost; ++i) {
           const double e2 = SampsonDistanceSquared(E, x_r[i], x_n[i]);
           count += e2 <= t2;
-          cost += std::min(e2, t2);
+          cost += e2 < t2 ? e2 : t2;  // a NaN distance (an infinite coordinate) costs the cap
         }
         // Only a lower cost is kept (a model cut short above the best is not).
         if (!(cost < best_cost)) continue;

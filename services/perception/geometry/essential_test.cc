@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include <Eigen/Geometry>
@@ -174,6 +175,26 @@ TEST(EstimateEssentialRansac, FindsTheMotionAmongOutliers) {
     // The adaptive stop: at two thirds inliers far fewer samples than the maximum.
     EXPECT_LT(r.iterations, 200) << trial;
     }
+  }
+}
+
+TEST(EstimateEssentialRansac, FivePointsTakeOneSampleAndAnInfinitePointIsAnOutlier) {
+  std::mt19937 rng(13);
+  Scene s = RandomScene(&rng, 100, 0.0005);
+  EssentialRansacOptions o;
+  o.threshold = 0.003;
+  EssentialRansacResult r;
+  const std::vector<Eigen::Vector2d> r5(s.x_r.begin(), s.x_r.begin() + 5), n5(s.x_n.begin(), s.x_n.begin() + 5);
+  ASSERT_TRUE(EstimateEssentialRansac(r5, n5, o, &r).ok());
+  EXPECT_EQ(r.iterations, 1);  // five distinct points: one sample, all inliers
+  EXPECT_EQ(r.num_inliers, 5);
+  s.x_n[7] = Eigen::Vector2d(std::numeric_limits<double>::infinity(), 0.1);
+  for (const bool msac : {false, true}) {
+    o.msac = msac;
+    ASSERT_TRUE(EstimateEssentialRansac(s.x_r, s.x_n, o, &r).ok()) << msac;
+    EXPECT_FALSE(r.inliers[7]) << msac;
+    EXPECT_GE(r.num_inliers, 95) << msac;
+    EXPECT_LT(DistanceUpToSign(r.E, s.E), 0.05) << msac;
   }
 }
 

@@ -63,7 +63,7 @@ struct TwoViewOptions {
   // inliers: with sliding, edge-like tracks a wrong direction can win the RANSAC by a few
   // inliers (0 = off).
   double heading_keep_ratio = 0.9;
-  // The essential matrix RANSAC: "mbslam" (the project's five-point solver, about ten
+  // The essential matrix RANSAC: "mbslam" (the project's five-point solver, about seven
   // times fewer instructions per sample) or "opencv" (cv::findEssentialMat).
   std::string essential_backend = "mbslam";
   // With the mbslam backend: the model with the lowest sum of capped squared Sampson
@@ -111,8 +111,8 @@ struct TwoViewOptions {
   }
 };
 
-// Robust relative motion from normalised correspondences x_r <-> x_n (Nister 5-point
-// RANSAC, pose recovery with cheirality), or a pure rotation when the parallax is too
+// Robust relative motion from normalised correspondences x_r <-> x_n (five-point
+// RANSAC, options.essential_backend; pose recovery with cheirality), or a pure rotation when the parallax is too
 // small for the translation to be observable. Translation has unit norm. The
 // covariance comes from the inliers' epipolar residuals (Gauss-Newton information).
 // `heading` (unit, optional): an expected translation direction, tried against the
