@@ -1,5 +1,7 @@
 #include "services/perception/geometry/essential.h"
 
+#include "services/perception/geometry/rigid3.h"
+
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -10,12 +12,6 @@
 
 namespace mbslam {
 namespace {
-
-Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
 
 struct Scene {
   Eigen::Matrix3d R;
