@@ -2,34 +2,53 @@
 # Scenario evaluations over several renderings (texture seeds) of the same scenes: mean, min and max of each key, so that a figure is not one rendering's luck
 #
 #   scripts/eval.sh sim-seeds [--scenarios "crossing following multi"] [--seeds "1 2 3"]
+#                             [--ransac-seeds "24301 1 2"]
 #   (env SERVICE_ARGS="--set a.b=v ..." passes options to the service)
 #
 # SIM_SEED changes the textures and with them the features; the geometry, the motions and
-# the truth stay. Each run is the scenario's own evaluation (sim-NAME), in lockstep;
-# outputs in MBSLAM_EVAL_OUT/NAME-seedS/. JSON (last line): {"NAME": {"KEY": {"mean",
-# "min", "max", "values"}, ...}, ...} over the keys below; a key a run could not compute
-# is left out of that run's values.
+# the truth stay. --ransac-seeds also runs each rendering with each of these seeds of the
+# segmentation's essential-matrix RANSAC (segmentation.two_view.ransac_seed; the default
+# is 24301): the same images, other random draws. Each run is the scenario's own
+# evaluation (sim-NAME), in lockstep; outputs in MBSLAM_EVAL_OUT/NAME-seedS/ (with RANSAC
+# seeds NAME-seedS-ransacR/). JSON (last line): {"NAME": {"KEY": {"mean", "min", "max",
+# "values"}, ...}, ...} over the keys below; a key a run could not compute is left out of
+# that run's values.
 set -euo pipefail
 source "$(dirname "$0")/_lib.sh"
 scenarios="crossing following multi"
 seeds="1 2 3"
+ransac_seeds=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --scenarios) scenarios="$2"; shift 2 ;;
     --seeds) seeds="$2"; shift 2 ;;
+    --ransac-seeds) ransac_seeds="$2"; shift 2 ;;
     *) echo "sim-seeds: unknown argument $1" >&2; echo '{}'; exit 2 ;;
   esac
 done
 results=()
+for r in $ransac_seeds; do
+  [[ "$r" =~ ^[0-9]+$ ]] || { echo "sim-seeds: --ransac-seeds takes whole numbers ($r)" >&2; echo '{}'; exit 2; }
+done
 for name in $scenarios; do
   for seed in $seeds; do
-    out="$MBSLAM_EVAL_OUT/$name-seed$seed"
-    mkdir -p "$out"
-    echo "== sim-$name, texture seed $seed" >&2
-    line=$(SIM_SEED="$seed" MBSLAM_EVAL_OUT="$out" "$MBSLAM_ROOT/scripts/eval.d/sim-$name.sh" 2>"$out/eval.log" | tail -1) || true
-    [[ "$line" == "{"* ]] || line="{}"
-    echo "$line" >"$out/result.json"
-    results+=("$name" "$seed" "$out/result.json")
+    for ransac in ${ransac_seeds:-default}; do
+      out="$MBSLAM_EVAL_OUT/$name-seed$seed"
+      label="$seed"
+      args="${SERVICE_ARGS:-}"
+      if [[ "$ransac" != default ]]; then
+        out="$out-ransac$ransac"
+        label="$seed/$ransac"
+        args="$args --set segmentation.two_view.ransac_seed=$ransac"
+      fi
+      mkdir -p "$out"
+      echo "== sim-$name, texture seed $seed${ransac_seeds:+, RANSAC seed $ransac}" >&2
+      line=$(SIM_SEED="$seed" SERVICE_ARGS="$args" MBSLAM_EVAL_OUT="$out" "$MBSLAM_ROOT/scripts/eval.d/sim-$name.sh" \
+        2>"$out/eval.log" | tail -1) || true
+      [[ "$line" == "{"* ]] || line="{}"
+      echo "$line" >"$out/result.json"
+      results+=("$name" "$label" "$out/result.json")
+    done
   done
 done
 python3 - "${results[@]}" <<'PY'
@@ -59,7 +78,7 @@ for i in range(0, len(args), 3):
 out = {}
 for name, rs in runs.items():
     agg = {}
-    print(f"sim-{name} over texture seeds {' '.join(s for s, _ in rs)}:")
+    print(f"sim-{name} over texture seeds (/ RANSAC seeds) {' '.join(s for s, _ in rs)}:")
     for k in keys:
         vals = [d[k] for _, d in rs if isinstance(d.get(k), (int, float))]
         if not vals:

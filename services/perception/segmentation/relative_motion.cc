@@ -428,6 +428,7 @@ Status EstimateRelativeMotion(const std::vector<Eigen::Vector2d>& x_r,
     ro.max_iterations = options.ransac_max_iterations;
     ro.min_iterations = options.ransac_min_iterations;
     ro.msac = options.ransac_msac;
+    ro.seed = static_cast<uint32_t>(options.ransac_seed);
     EssentialRansacResult rr;
     if (EstimateEssentialRansac(x_r, x_n, ro, &rr).ok()) {
       cv::eigen2cv(rr.E, E);

@@ -70,6 +70,10 @@ struct TwoViewOptions {
   // distances wins, not the one with the most inliers (on TartanAir the ATE varied less
   // with the sampler's seed: 0.93-1.03 % against 1.00-1.30 % over four / three seeds).
   bool ransac_msac = true;
+  // With the mbslam backend: the sampler's seed (each call starts from it, so a result
+  // depends only on its input). Another seed is another draw: the evaluations' spread
+  // over seeds is how much of a change is the draw's.
+  int64_t ransac_seed = 0x5eed;
 
   bool Check() const {
     MBSLAM_CHECK_OPTION_GT(sigma_px, 0.0);
@@ -84,6 +88,7 @@ struct TwoViewOptions {
     MBSLAM_CHECK_OPTION(front_keep_ratio >= 0.0 && front_keep_ratio <= 1.0);
     MBSLAM_CHECK_OPTION(heading_keep_ratio >= 0.0 && heading_keep_ratio <= 1.0);
     MBSLAM_CHECK_OPTION(essential_backend == "mbslam" || essential_backend == "opencv");
+    MBSLAM_CHECK_OPTION(ransac_seed >= 0 && ransac_seed <= 0xffffffffll);
     return true;
   }
   template <typename V>
@@ -108,6 +113,7 @@ struct TwoViewOptions {
       "essential matrix RANSAC: mbslam (the project's five-point solver, faster) or opencv (cv::findEssentialMat)");
     v("ransac_msac", &ransac_msac,
       "mbslam backend: the lowest sum of capped squared errors wins (MSAC), not the most inliers");
+    v("ransac_seed", &ransac_seed, "mbslam backend: the sampler's seed, the same for every call (another seed, another draw)");
   }
 };
 
