@@ -19,6 +19,15 @@ inline double Median(std::vector<double> v) {
   return v[mid];
 }
 
+// The median of v as reports give it: the mean of the two middle values of an even
+// count; 0 for an empty v.
+inline double MedianOfReport(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
 // The median absolute deviation of v about `centre`. kMadToSigma times it is the
 // standard deviation of a normal distribution.
 inline double MedianAbsoluteDeviation(const std::vector<double>& v, double centre) {

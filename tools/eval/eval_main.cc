@@ -26,6 +26,7 @@
 #include "common/lcm/channels.h"
 #include "common/util/atomic_file.h"
 #include "common/util/command_line.h"
+#include "common/util/statistics.h"
 #include "tools/eval/camera_metrics.h"
 #include "tools/eval/datasets.h"
 #include "tools/eval/json.h"
@@ -226,15 +227,6 @@ Status LoadTruthLabels(const std::string& path, std::vector<int>* labels) {
   return eval::ReadLabelFile(path, labels);
 }
 
-double Median(std::vector<double> v) {
-  if (v.empty()) {
-    return 0.0;
-  }
-  std::sort(v.begin(), v.end());
-  const size_t m = v.size() / 2;
-  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
-
 int RunSeg(const mbslam::CommandLineArgs& args) {
   if (args.Has("pred") && args.Has("truth")) {
     std::vector<int> pred, truth;
@@ -306,13 +298,13 @@ int RunSeg(const mbslam::CommandLineArgs& args) {
     };
     for (const auto& g : by_groups) {
       std::printf("%d groups: %zu sequences, mean %.4f, median %.4f\n", g.first, g.second.size(),
-                  mean(g.second), Median(g.second));
+                  mean(g.second), mbslam::MedianOfReport(g.second));
       j.Set(std::to_string(g.first) + "_groups_mean", mean(g.second));
-      j.Set(std::to_string(g.first) + "_groups_median", Median(g.second));
+      j.Set(std::to_string(g.first) + "_groups_median", mbslam::MedianOfReport(g.second));
     }
     std::printf("all: %zu sequences, mean %.4f, median %.4f (%d without predictions)\n", all.size(),
-                mean(all), Median(all), missing);
-    j.Set("all_mean", mean(all)).Set("all_median", Median(all)).Set("per_sequence", per);
+                mean(all), mbslam::MedianOfReport(all), missing);
+    j.Set("all_mean", mean(all)).Set("all_median", mbslam::MedianOfReport(all)).Set("per_sequence", per);
     return Finish(j, args);
   }
   return Fail("seg: give --pred FILE --truth FILE, or --pred-dir DIR [--tracks-dir DIR]");
@@ -400,10 +392,10 @@ int RunMasks(const mbslam::CommandLineArgs& args) {
   }
   const double mean = sum / static_cast<double>(ious.size());
   std::printf("region IoU over %zu frames: mean %.4f, median %.4f (%d frames without prediction)\n",
-              ious.size(), mean, Median(ious), missing);
+              ious.size(), mean, mbslam::MedianOfReport(ious), missing);
   Json j = Json::Object();
   j.Set("metric", "masks").Set("frames", ious.size()).Set("missing", missing).Set("iou_mean", mean);
-  j.Set("iou_median", Median(ious));
+  j.Set("iou_median", mbslam::MedianOfReport(ious));
   if (!features.empty()) {
     std::printf("moving features: precision %.4f, recall %.4f (TP %d, FP %d, FN %d)\n",
                 total.precision, total.recall, total.true_positives, total.false_positives,

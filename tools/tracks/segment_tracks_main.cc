@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "common/util/command_line.h"
+#include "common/util/statistics.h"
 #include "services/perception/segmentation/motion_segmenter.h"
 #include "services/perception/segmentation/subspace_clustering.h"
 #include "services/perception/segmentation/tracks_file.h"
@@ -68,13 +69,6 @@ double Mean(const std::vector<double>& v) {
   double s = 0.0;
   for (double x : v) s += x;
   return s / static_cast<double>(v.size());
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 int Run(int argc, char** argv) {
@@ -207,7 +201,7 @@ int Run(int argc, char** argv) {
   auto report = [](const char* name, std::map<std::string, std::vector<double>>& m) {
     for (const char* g : {"2", "3", "all"}) {
       std::printf("%-8s %-4s motions: mean %6.2f%%  median %6.2f%%  (n=%zu)\n", name, g,
-                  100.0 * Mean(m[g]), 100.0 * Median(m[g]), m[g].size());
+                  100.0 * Mean(m[g]), 100.0 * MedianOfReport(m[g]), m[g].size());
     }
   };
   if (do_known) report("known_k", known);
@@ -221,20 +215,20 @@ int Run(int argc, char** argv) {
   };
   if (do_known) {
     add("mean_2_known_k", Mean(known["2"]));
-    add("median_2_known_k", Median(known["2"]));
+    add("median_2_known_k", MedianOfReport(known["2"]));
     add("mean_3_known_k", Mean(known["3"]));
-    add("median_3_known_k", Median(known["3"]));
+    add("median_3_known_k", MedianOfReport(known["3"]));
     add("mean_all_known_k", Mean(known["all"]));
-    add("median_all_known_k", Median(known["all"]));
+    add("median_all_known_k", MedianOfReport(known["all"]));
     add("seconds_known_k", seconds_known);
   }
   if (do_online) {
     add("mean_2_online", Mean(online["2"]));
-    add("median_2_online", Median(online["2"]));
+    add("median_2_online", MedianOfReport(online["2"]));
     add("mean_3_online", Mean(online["3"]));
-    add("median_3_online", Median(online["3"]));
+    add("median_3_online", MedianOfReport(online["3"]));
     add("mean_all_online", Mean(online["all"]));
-    add("median_all_online", Median(online["all"]));
+    add("median_all_online", MedianOfReport(online["all"]));
     add("online_group_count_correct", sequences ? static_cast<double>(online_k_right) / sequences : 0.0);
     add("seconds_online", seconds_online);
   }
