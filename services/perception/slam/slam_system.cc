@@ -68,7 +68,8 @@ const char* SlamStateName(SlamState state) {
   return "unknown";
 }
 
-SlamSystem::SlamSystem(const SlamOptions& options) : options_(options) {
+SlamSystem::SlamSystem(const SlamOptions& options, std::string log_name)
+    : options_(options), log_name_(std::move(log_name)) {
   if (!options_.map_load_path.empty()) {
     const Status s = LoadMap(options_.map_load_path);
     if (!s.ok()) MBSLAM_LOG(WARNING) << "map not loaded: " << s.message();
@@ -150,7 +151,7 @@ void SlamSystem::RecordTrajectory(int64_t frame, const Rigid3d& T, const Keyfram
   if (options_.adjusted_trajectory_max_poses <= 0) return;
   auto u = frame_utime_.find(frame);
   if (u == frame_utime_.end()) {
-    MBSLAM_LOG(WARNING) << "SLAM: the pose of image " << frame << " is left out of the trajectory file: its time is no longer kept";
+    MBSLAM_LOG(WARNING) << log_name_ << ": the pose of image " << frame << " is left out of the trajectory file: its time is no longer kept";
     return;
   }
   TrajectoryEntry e;
@@ -328,7 +329,7 @@ void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
     uv->push_back(m.uv);
     xy->push_back(K.PixelToNormalized(m.uv.cast<double>()));
   }
-  MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": guided matching over " << candidates.size()
+  MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": guided matching over " << candidates.size()
                     << " points of the last keyframes: " << tracked << " held by tracks (" << ended
                     << " of them ended), " << outside << " outside, "
                     << searched << " searched, " << ambiguous << " ambiguous, " << unlike << " unlike, "
@@ -433,7 +434,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   PoseEstimate est;
   if (X.size() >= 6) est = EstimatePose(X, xy, frame.focal_px, prior, options_.pose, TrackingRotationPrior(frame));
   bool good = est.ok && est.num_inliers >= options_.min_tracking_inliers;
-  MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": correspondences " << X.size() << " (re-found "
+  MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": correspondences " << X.size() << " (re-found "
                     << refound_ids.size() << "), inliers " << est.num_inliers << ", rms " << est.rms_px
                     << " px, points " << map_.num_points() << ", keyframes " << map_.num_keyframes();
   bool assisted = false;
@@ -446,7 +447,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   if (good && state_ == SlamState::kConfirming) {
     const double ratio = static_cast<double>(est.num_inliers) / static_cast<double>(X.size());
     if (ratio < options_.init_confirm_inlier_ratio) {
-      MBSLAM_LOG(INFO) << "SLAM: new map not confirmed (inlier share " << ratio << "); retrying";
+      MBSLAM_LOG(INFO) << log_name_ << ": new map not confirmed (inlier share " << ratio << "); retrying";
       RestartMap(bridge_);
       out.state = state_;
       RememberUnposed(frame);
@@ -456,7 +457,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
       state_ = SlamState::kTracking;
       bridge_.reset();
       out.relocalized = just_initialized_;
-      MBSLAM_LOG(INFO) << "SLAM: map confirmed (" << map_.num_points() << " points)";
+      MBSLAM_LOG(INFO) << log_name_ << ": map confirmed (" << map_.num_points() << " points)";
       BackfillPoses(frame.frame_index, &out);
     }
   }
@@ -527,7 +528,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     } else {
       state_ = SlamState::kLost;
       if (lost_frames_ >= options_.lost_frames_to_reinit) {
-        MBSLAM_LOG(WARNING) << "SLAM: lost for " << lost_frames_ << " frames; re-initialising";
+        MBSLAM_LOG(WARNING) << log_name_ << ": lost for " << lost_frames_ << " frames; re-initialising";
         // A bundle adjustment still running is waited for by the restart anyway: its
         // result is merged first, for the pose and the depths the bridge carries over.
         MergeBundleAdjustment(/*wait=*/true);
@@ -607,7 +608,7 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
     links.references.push_back(*T);
   }
   if (static_cast<int>(links.xy_ref.size()) < options_.hybrid_min_links) {
-    MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": epipolar-assisted pose refused, " << links.xy_ref.size()
+    MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": epipolar-assisted pose refused, " << links.xy_ref.size()
                       << " tracks linked (" << edge_like.size() << " edge-like tracks left out)";
     return false;
   }
@@ -641,7 +642,7 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
                                options_.hybrid_length_sigma, frame.focal_px, options_.pose);
   const bool ok = h.pose.ok && h.num_link_inliers >= options_.hybrid_min_links &&
                   h.num_link_inliers >= options_.hybrid_min_link_ratio * static_cast<double>(links.xy_ref.size());
-  MBSLAM_LOG(DEBUG) << "SLAM frame " << frame.frame_index << ": epipolar-assisted pose, " << h.num_link_inliers
+  MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": epipolar-assisted pose, " << h.num_link_inliers
                     << " of " << links.xy_ref.size() << " tracks linked to images " << ref_frames.front() << "-"
                     << ref_frames.back() << " (rms " << h.link_rms_px << " px), " << h.pose.num_inliers << " of "
                     << X.size() << " map points, " << edge_like.size() << " edge-like tracks left out"
@@ -679,12 +680,12 @@ void SlamSystem::BackfillPoses(int64_t frame, SlamPose* out) {
       xy.push_back(x);
     }
     if (X.size() < 6) {
-      MBSLAM_LOG(DEBUG) << "SLAM backfill of frame " << f << ": " << obs.size() << " observations, "
+      MBSLAM_LOG(DEBUG) << log_name_ << " backfill of frame " << f << ": " << obs.size() << " observations, "
                         << X.size() << " with points: too few";
       continue;
     }
     const PoseEstimate est = EstimatePose(X, xy, focal_px_, std::nullopt, options_.pose);
-    MBSLAM_LOG(DEBUG) << "SLAM backfill of frame " << f << ": " << obs.size() << " observations, " << X.size()
+    MBSLAM_LOG(DEBUG) << log_name_ << " backfill of frame " << f << ": " << obs.size() << " observations, " << X.size()
                       << " with points, " << est.num_inliers << " inliers" << (est.ok ? "" : " (failed)");
     if (est.ok && est.num_inliers >= options_.min_tracking_inliers) out->backfilled.emplace_back(f, est.cam_from_world);
   }
@@ -700,7 +701,7 @@ void SlamSystem::BackfillPoses(int64_t frame, SlamPose* out) {
   const size_t earlier = static_cast<size_t>(std::count_if(
       unposed_.begin(), unposed_.end(), [frame](const auto& u) { return u.first < frame; }));
   if (earlier > 0) {
-    MBSLAM_LOG(INFO) << "SLAM: poses of " << out->backfilled.size() << " of " << earlier
+    MBSLAM_LOG(INFO) << log_name_ << ": poses of " << out->backfilled.size() << " of " << earlier
                      << " earlier images recovered against the map";
   }
   unposed_.clear();
@@ -743,7 +744,7 @@ bool SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
 void SlamSystem::BuildWaitingPair(int64_t frame_index, const char* why, SlamPose* out) {
   const InitPair pair = std::move(*init_pending_pair_);
   init_pending_pair_.reset();
-  MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame_index << ": " << why << ", the pair of frames " << pair.ref_frame
+  MBSLAM_LOG(DEBUG) << log_name_ << " init at frame " << frame_index << ": " << why << ", the pair of frames " << pair.ref_frame
                     << "-" << pair.frame_index << " (waiting for parallax) makes the map";
   BuildInitialMap(pair, out);
 }
@@ -815,7 +816,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     const int g = SelectStaticGroup(groups, options_.init_min_coverage, options_.init_max_hull_share);
     if (GetLogLevel() <= LogLevel::kDebug) {
       for (size_t k = 0; k < groups.size(); ++k) {
-        MBSLAM_LOG(DEBUG) << "SLAM init frame " << frame.frame_index << ": motion " << k << " of " << ids.size()
+        MBSLAM_LOG(DEBUG) << log_name_ << " init frame " << frame.frame_index << ": motion " << k << " of " << ids.size()
                           << " tracks: " << groups[k].count << " inliers, coverage " << groups[k].coverage
                           << ", in hulls " << groups[k].hull_share;
       }
@@ -827,7 +828,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
       all[0].inliers.assign(ids.size(), 1);
       all[0].count = static_cast<int>(ids.size());
       ScoreMotionGroups(xn, all_xy, {}, kInitGridCols, kInitGridRows, &all);
-      MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": no broad static motion among "
+      MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": no broad static motion among "
                         << groups.size() << " (largest: " << (groups.empty() ? 0 : groups[0].count)
                         << " inliers, coverage " << (groups.empty() ? 0.0 : groups[0].coverage) << ", in hulls "
                         << (groups.empty() ? 0.0 : groups[0].hull_share) << "); shared tracks cover "
@@ -841,7 +842,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     // the map, and the other motions' tracks are kept out of both views.
     if (g > 0) {
       const InitMotionGroup& chosen = groups[static_cast<size_t>(g)];
-      MBSLAM_LOG(INFO) << "SLAM init at frame " << frame.frame_index << ": motion " << g << " (" << chosen.count
+      MBSLAM_LOG(INFO) << log_name_ << " init at frame " << frame.frame_index << ": motion " << g << " (" << chosen.count
                        << " inliers, coverage " << chosen.coverage << ") is the static world, not the largest ("
                        << groups[0].count << " inliers, coverage " << groups[0].coverage << ")";
       std::vector<int64_t> ids_g;
@@ -876,7 +877,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
   std::vector<Candidate> candidates;
   const EssentialFit fit = FitEssential(xr, xn, thresh);
   if (!fit.ok()) {
-    MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": no essential matrix";
+    MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": no essential matrix";
     return InitAttempt::kRefusedGeometry;
   }
   const std::vector<cv::Point2d>& pr = fit.pr;
@@ -902,7 +903,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
       for (size_t i = 0; i < n; ++i) mask.at<uint8_t>(static_cast<int>(i)) = kt->inliers[i];
       for (double sign : {1.0, -1.0}) candidates.push_back(Candidate{Rigid3d(R, sign * kt->t_unit), mask});
     }
-    MBSLAM_LOG(DEBUG) << "SLAM init frame " << frame.frame_index << ": known rotation explains "
+    MBSLAM_LOG(DEBUG) << log_name_ << " init frame " << frame.frame_index << ": known rotation explains "
                       << (kt ? kt->count : 0) << " of the essential matrix's " << e_inl << " inliers"
                       << (rotation_prior_active_ ? "" : ": the body turns, no rotation prior");
   }
@@ -920,7 +921,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
       // (measured as it is on the simulated scenes, TartanAir and DAVIS).
       const int in_front = cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask);
       if (in_front < options_.init_min_points) {
-        MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": E inliers " << e_inl
+        MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": E inliers " << e_inl
                           << ", H inliers " << h_inl << ", " << in_front << " in front of both views within 50 baselines";
         return InitAttempt::kRefusedParallax;
       }
@@ -971,7 +972,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
   }
   if (!best || static_cast<int>(best->points.size()) < options_.init_min_points ||
       best->median_parallax < options_.init_min_parallax_deg * kDeg) {
-    MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": E inliers " << e_inl
+    MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": E inliers " << e_inl
                       << ", H inliers " << h_inl << (planar ? " (planar)" : "") << ", points "
                       << (best ? best->points.size() : 0) << ", median parallax "
                       << (best ? best->median_parallax / kDeg : 0.0) << " deg";
@@ -1000,7 +1001,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
                       /*require_majority=*/false);
     map_coverage = mapped[0].coverage;
     if (SelectStaticGroup(mapped, options_.init_min_coverage, options_.init_max_hull_share) < 0) {
-      MBSLAM_LOG(DEBUG) << "SLAM init refused at frame " << frame.frame_index << ": the " << best->points.size()
+      MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": the " << best->points.size()
                         << " points with parallax cover " << map_coverage << " of the image, "
                         << mapped[0].hull_share << " inside moving hulls";
       return InitAttempt::kRefusedTracks;
@@ -1049,7 +1050,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     }
     if (waited < options_.init_wait_frames && reachable &&
         shared >= options_.init_wait_keep_ratio * init_pending_tracks_) {
-      MBSLAM_LOG(DEBUG) << "SLAM init at frame " << frame.frame_index << " deferred: median parallax "
+      MBSLAM_LOG(DEBUG) << log_name_ << " init at frame " << frame.frame_index << " deferred: median parallax "
                         << best->median_parallax / kDeg << " deg, " << shared << " of " << init_pending_tracks_
                         << " tracks shared (acceptable since frame " << init_pending_frame_ << ")";
       if (!options_.init_keep_best_pair || !init_pending_pair_ ||
@@ -1152,7 +1153,7 @@ void SlamSystem::BuildInitialMap(const InitPair& pair, SlamPose* out) {
   tracked_points_at_keyframe_ = static_cast<int>(map_.num_points());
   state_ = options_.init_confirm_frames > 0 ? SlamState::kConfirming : SlamState::kTracking;
   confirm_count_ = 0;
-  MBSLAM_LOG(INFO) << "SLAM: initialised from frames " << pair.ref_frame << "-" << pair.frame_index << " with "
+  MBSLAM_LOG(INFO) << log_name_ << ": initialised from frames " << pair.ref_frame << "-" << pair.frame_index << " with "
                    << map_.num_points() << " points (" << (pair.planar ? "homography" : "essential")
                    << ", median parallax " << pair.median_parallax_rad / kDeg << " deg, coverage " << pair.coverage
                    << (metric_ ? ", metric scale from odometry" : "") << ")";
@@ -1201,7 +1202,7 @@ void SlamSystem::ApplyBridge(int64_t ref_frame, int64_t cur_frame) {
     pose.cam_from_world.translation *= scale;
     pose.cam_from_world = pose.cam_from_world * old_from_new.Inverse();
   }
-  MBSLAM_LOG(INFO) << "SLAM: new map continues the previous world frame (gap of " << ref_frame - b.frame
+  MBSLAM_LOG(INFO) << log_name_ << ": new map continues the previous world frame (gap of " << ref_frame - b.frame
                    << " frames, scale x" << scale << ")";
 }
 
@@ -1265,7 +1266,7 @@ bool SlamSystem::RotationPriorHolds(const SlamFrame& frame, const std::unordered
       (frame.rotation_prior->cam_from_ref * ref->rotation_prior->cam_from_ref.conjugate()).toRotationMatrix();
   const std::optional<KnownRotationTranslation> kt = TranslationGivenRotation(xr, xn, R, thresh, 200);
   const int known = kt ? kt->count : 0;
-  MBSLAM_LOG(DEBUG) << "SLAM keyframe at frame " << frame.frame_index << ": from frame " << ref->frame_index
+  MBSLAM_LOG(DEBUG) << log_name_ << " keyframe at frame " << frame.frame_index << ": from frame " << ref->frame_index
                     << " the known rotation explains " << known << " of the essential matrix's " << e_inl
                     << " inliers";
   return RotationPriorStillHolds(known, e_inl, options_.rotation_prior_keep_inlier_ratio);
@@ -1276,7 +1277,7 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
   if (rotation_prior_active_ && options_.rotation_prior_keep_inlier_ratio > 0.0 &&
       !RotationPriorHolds(frame, labels)) {
     rotation_prior_active_ = false;
-    MBSLAM_LOG(INFO) << "SLAM: the body turns at frame " << frame.frame_index
+    MBSLAM_LOG(INFO) << log_name_ << ": the body turns at frame " << frame.frame_index
                      << ": no rotation prior for the rest of this map";
   }
   const Rigid3d T = *PoseOf(frame.frame_index);
@@ -1364,7 +1365,7 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
     update->new_point_ids.push_back(new_pid);
   }
   tracked_points_at_keyframe_ = tracked + static_cast<int>(update->new_point_ids.size());
-  MBSLAM_LOG(DEBUG) << "SLAM keyframe at image " << frame.frame_index << ": " << k.track_xy.size() << " static tracks, "
+  MBSLAM_LOG(DEBUG) << log_name_ << " keyframe at image " << frame.frame_index << ": " << k.track_xy.size() << " static tracks, "
                     << tracked << " on points, " << update->new_point_ids.size() << " new points; not triangulated: "
                     << unseen << " unseen by the last keyframes, " << degenerate << " degenerate, " << low_parallax
                     << " low parallax, " << reprojection << " reprojection, " << released << " released before";
@@ -1404,7 +1405,7 @@ std::optional<double> SlamSystem::EstablishMetricScale() {
     pose.covariance.bottomLeftCorner<3, 3>() *= s;
   }
   metric_ = true;
-  MBSLAM_LOG(INFO) << "SLAM: metric scale from odometry (x" << s << " over a " << odo << " m baseline)";
+  MBSLAM_LOG(INFO) << log_name_ << ": metric scale from odometry (x" << s << " over a " << odo << " m baseline)";
   return s;
 }
 

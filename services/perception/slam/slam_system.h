@@ -24,6 +24,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 #include <unordered_map>
 #include <unordered_set>
@@ -416,7 +417,9 @@ bool RotationPriorStillHolds(int known, int essential, double ratio);
 
 class SlamSystem {
  public:
-  explicit SlamSystem(const SlamOptions& options);
+  // `log_name` starts this map's log lines ("SLAM" for the static world's, "object N
+  // SLAM" for a moving object's: several run in one process).
+  explicit SlamSystem(const SlamOptions& options, std::string log_name = "SLAM");
   ~SlamSystem();
   SlamSystem(const SlamSystem&) = delete;
   SlamSystem& operator=(const SlamSystem&) = delete;
@@ -555,6 +558,7 @@ class SlamSystem {
                            std::vector<Eigen::Vector2f>* uv);
 
   const SlamOptions options_;
+  const std::string log_name_;
   Map map_;
   SlamState state_ = SlamState::kNotInitialized;
   double focal_px_ = 1.0;
