@@ -6,9 +6,10 @@
 #   (env SERVICE_ARGS="--set a.b=v ..." passes options to the service)
 #
 # SIM_SEED changes the textures and with them the features; the geometry, the motions and
-# the truth stay. --ransac-seeds also runs each rendering with each of these seeds of the
-# segmentation's essential-matrix RANSAC (segmentation.two_view.ransac_seed; the default
-# is 24301): the same images, other random draws. Each run is the scenario's own
+# the truth stay. --ransac-seeds runs each rendering once per listed seed of the
+# segmentation's essential-matrix RANSAC (segmentation.two_view.ransac_seed; list 24301,
+# the default, to include the usual run): the same images, other draws of the
+# segmentation (SLAM's own essential-matrix fits keep theirs). Each run is the scenario's own
 # evaluation (sim-NAME), in lockstep; outputs in MBSLAM_EVAL_OUT/NAME-seedS/ (with RANSAC
 # seeds NAME-seedS-ransacR/). JSON (last line): {"NAME": {"KEY": {"mean", "min", "max",
 # "values"}, ...}, ...} over the keys below; a key a run could not compute is left out of
@@ -27,9 +28,15 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 results=()
+# Whole numbers in the service's range, each once (blank = the default run only).
+checked=""
 for r in $ransac_seeds; do
-  [[ "$r" =~ ^[0-9]+$ ]] || { echo "sim-seeds: --ransac-seeds takes whole numbers ($r)" >&2; echo '{}'; exit 2; }
+  if ! [[ "$r" =~ ^(0|[1-9][0-9]{0,9})$ ]] || (( r > 4294967295 )); then
+    echo "sim-seeds: --ransac-seeds takes whole numbers 0-4294967295 ($r)" >&2; echo '{}'; exit 2
+  fi
+  [[ " $checked " == *" $r "* ]] || checked="${checked:+$checked }$r"
 done
+ransac_seeds="$checked"
 for name in $scenarios; do
   for seed in $seeds; do
     for ransac in ${ransac_seeds:-default}; do
@@ -78,7 +85,8 @@ for i in range(0, len(args), 3):
 out = {}
 for name, rs in runs.items():
     agg = {}
-    print(f"sim-{name} over texture seeds (/ RANSAC seeds) {' '.join(s for s, _ in rs)}:")
+    with_ransac = any("/" in s for s, _ in rs)
+    print(f"sim-{name} over texture seeds{' / RANSAC seeds' if with_ransac else ''} {' '.join(s for s, _ in rs)}:")
     for k in keys:
         vals = [d[k] for _, d in rs if isinstance(d.get(k), (int, float))]
         if not vals:

@@ -72,7 +72,8 @@ struct TwoViewOptions {
   bool ransac_msac = true;
   // With the mbslam backend: the sampler's seed (each call starts from it, so a result
   // depends only on its input). Another seed is another draw: the evaluations' spread
-  // over seeds is how much of a change is the draw's.
+  // over seeds is how much of a change is the draw's. (The segmentation's options: SLAM's
+  // epipolar-assisted pose keeps the default, its initialisation uses OpenCV's RANSAC.)
   int64_t ransac_seed = 0x5eed;
 
   bool Check() const {

@@ -235,6 +235,7 @@ TEST(RelativeMotion, TheSeedChoosesTheDraw) {
   estimate(TwoViewOptions().ransac_seed, &b, &ib);
   EXPECT_EQ(ia, ib);
   EXPECT_EQ(a.cam_n_from_cam_r.translation, b.cam_n_from_cam_r.translation);
+  EXPECT_EQ(a.cam_n_from_cam_r.rotation.coeffs(), b.cam_n_from_cam_r.rotation.coeffs());
   int differing = 0, close = 0;
   for (int64_t seed : {1, 2, 3, 4, 5}) {
     RelativeMotion m;

@@ -325,7 +325,8 @@ std::vector<ObjectReconstructionResult> ObjectReconstruction::Update(int64_t fra
     if (static_cast<int>(entries_.size()) >= options_.max_objects) break;
     if (entries_.count(o->id) || static_cast<int>(o->track_ids.size()) < options_.min_tracks) continue;
     Entry e;
-    e.slam = std::make_unique<SlamSystem>(slam_options_, "object " + std::to_string(o->id) + " SLAM");
+    e.slam =
+        std::make_unique<SlamSystem>(slam_options_, "object " + std::to_string(o->id) + " SLAM");
     e.last_seen_frame = frame_index;
     entries_.emplace(o->id, std::move(e));
     MBSLAM_LOG(INFO) << "object " << o->id << ": reconstruction started (" << o->track_ids.size() << " tracks)";

@@ -151,7 +151,8 @@ void SlamSystem::RecordTrajectory(int64_t frame, const Rigid3d& T, const Keyfram
   if (options_.adjusted_trajectory_max_poses <= 0) return;
   auto u = frame_utime_.find(frame);
   if (u == frame_utime_.end()) {
-    MBSLAM_LOG(WARNING) << log_name_ << ": the pose of image " << frame << " is left out of the trajectory file: its time is no longer kept";
+    MBSLAM_LOG(WARNING) << log_name_ << ": the pose of image " << frame
+                        << " is left out of the trajectory file: its time is no longer kept";
     return;
   }
   TrajectoryEntry e;
@@ -329,11 +330,11 @@ void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
     uv->push_back(m.uv);
     xy->push_back(K.PixelToNormalized(m.uv.cast<double>()));
   }
-  MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": guided matching over " << candidates.size()
-                    << " points of the last keyframes: " << tracked << " held by tracks (" << ended
-                    << " of them ended), " << outside << " outside, "
-                    << searched << " searched, " << ambiguous << " ambiguous, " << unlike << " unlike, "
-                    << point_ids->size() << " re-found";
+  MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": guided matching over "
+                    << candidates.size() << " points of the last keyframes: " << tracked
+                    << " held by tracks (" << ended << " of them ended), " << outside
+                    << " outside, " << searched << " searched, " << ambiguous << " ambiguous, "
+                    << unlike << " unlike, " << point_ids->size() << " re-found";
 }
 
 std::optional<Rigid3d> SlamSystem::PredictPose(const SlamFrame& frame) const {
@@ -434,9 +435,10 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   PoseEstimate est;
   if (X.size() >= 6) est = EstimatePose(X, xy, frame.focal_px, prior, options_.pose, TrackingRotationPrior(frame));
   bool good = est.ok && est.num_inliers >= options_.min_tracking_inliers;
-  MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": correspondences " << X.size() << " (re-found "
-                    << refound_ids.size() << "), inliers " << est.num_inliers << ", rms " << est.rms_px
-                    << " px, points " << map_.num_points() << ", keyframes " << map_.num_keyframes();
+  MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": correspondences "
+                    << X.size() << " (re-found " << refound_ids.size() << "), inliers "
+                    << est.num_inliers << ", rms " << est.rms_px << " px, points "
+                    << map_.num_points() << ", keyframes " << map_.num_keyframes();
   bool assisted = false;
   if (!good && options_.hybrid_tracking && (state_ == SlamState::kTracking || state_ == SlamState::kLost) && prior &&
       hybrid_frames_ < options_.hybrid_max_frames) {
@@ -447,7 +449,8 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   if (good && state_ == SlamState::kConfirming) {
     const double ratio = static_cast<double>(est.num_inliers) / static_cast<double>(X.size());
     if (ratio < options_.init_confirm_inlier_ratio) {
-      MBSLAM_LOG(INFO) << log_name_ << ": new map not confirmed (inlier share " << ratio << "); retrying";
+      MBSLAM_LOG(INFO) << log_name_ << ": new map not confirmed (inlier share " << ratio
+                       << "); retrying";
       RestartMap(bridge_);
       out.state = state_;
       RememberUnposed(frame);
@@ -528,7 +531,8 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     } else {
       state_ = SlamState::kLost;
       if (lost_frames_ >= options_.lost_frames_to_reinit) {
-        MBSLAM_LOG(WARNING) << log_name_ << ": lost for " << lost_frames_ << " frames; re-initialising";
+        MBSLAM_LOG(WARNING) << log_name_ << ": lost for " << lost_frames_
+                            << " frames; re-initialising";
         // A bundle adjustment still running is waited for by the restart anyway: its
         // result is merged first, for the pose and the depths the bridge carries over.
         MergeBundleAdjustment(/*wait=*/true);
@@ -608,7 +612,8 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
     links.references.push_back(*T);
   }
   if (static_cast<int>(links.xy_ref.size()) < options_.hybrid_min_links) {
-    MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": epipolar-assisted pose refused, " << links.xy_ref.size()
+    MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index
+                      << ": epipolar-assisted pose refused, " << links.xy_ref.size()
                       << " tracks linked (" << edge_like.size() << " edge-like tracks left out)";
     return false;
   }
@@ -642,11 +647,12 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
                                options_.hybrid_length_sigma, frame.focal_px, options_.pose);
   const bool ok = h.pose.ok && h.num_link_inliers >= options_.hybrid_min_links &&
                   h.num_link_inliers >= options_.hybrid_min_link_ratio * static_cast<double>(links.xy_ref.size());
-  MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": epipolar-assisted pose, " << h.num_link_inliers
-                    << " of " << links.xy_ref.size() << " tracks linked to images " << ref_frames.front() << "-"
-                    << ref_frames.back() << " (rms " << h.link_rms_px << " px), " << h.pose.num_inliers << " of "
-                    << X.size() << " map points, " << edge_like.size() << " edge-like tracks left out"
-                    << (ok ? "" : ": refused");
+  MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": epipolar-assisted pose, "
+                    << h.num_link_inliers << " of " << links.xy_ref.size()
+                    << " tracks linked to images " << ref_frames.front() << "-" << ref_frames.back()
+                    << " (rms " << h.link_rms_px << " px), " << h.pose.num_inliers << " of "
+                    << X.size() << " map points, " << edge_like.size()
+                    << " edge-like tracks left out" << (ok ? "" : ": refused");
   if (!ok) return false;
   *est = h.pose;
   return true;
@@ -680,13 +686,14 @@ void SlamSystem::BackfillPoses(int64_t frame, SlamPose* out) {
       xy.push_back(x);
     }
     if (X.size() < 6) {
-      MBSLAM_LOG(DEBUG) << log_name_ << " backfill of frame " << f << ": " << obs.size() << " observations, "
-                        << X.size() << " with points: too few";
+      MBSLAM_LOG(DEBUG) << log_name_ << " backfill of frame " << f << ": " << obs.size()
+                        << " observations, " << X.size() << " with points: too few";
       continue;
     }
     const PoseEstimate est = EstimatePose(X, xy, focal_px_, std::nullopt, options_.pose);
-    MBSLAM_LOG(DEBUG) << log_name_ << " backfill of frame " << f << ": " << obs.size() << " observations, " << X.size()
-                      << " with points, " << est.num_inliers << " inliers" << (est.ok ? "" : " (failed)");
+    MBSLAM_LOG(DEBUG) << log_name_ << " backfill of frame " << f << ": " << obs.size()
+                      << " observations, " << X.size() << " with points, " << est.num_inliers
+                      << " inliers" << (est.ok ? "" : " (failed)");
     if (est.ok && est.num_inliers >= options_.min_tracking_inliers) out->backfilled.emplace_back(f, est.cam_from_world);
   }
   for (const auto& [f, T] : out->backfilled) {
@@ -744,8 +751,9 @@ bool SlamSystem::TryInitialize(const SlamFrame& frame, SlamPose* out) {
 void SlamSystem::BuildWaitingPair(int64_t frame_index, const char* why, SlamPose* out) {
   const InitPair pair = std::move(*init_pending_pair_);
   init_pending_pair_.reset();
-  MBSLAM_LOG(DEBUG) << log_name_ << " init at frame " << frame_index << ": " << why << ", the pair of frames " << pair.ref_frame
-                    << "-" << pair.frame_index << " (waiting for parallax) makes the map";
+  MBSLAM_LOG(DEBUG) << log_name_ << " init at frame " << frame_index << ": " << why
+                    << ", the pair of frames " << pair.ref_frame << "-" << pair.frame_index
+                    << " (waiting for parallax) makes the map";
   BuildInitialMap(pair, out);
 }
 
@@ -816,9 +824,10 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     const int g = SelectStaticGroup(groups, options_.init_min_coverage, options_.init_max_hull_share);
     if (GetLogLevel() <= LogLevel::kDebug) {
       for (size_t k = 0; k < groups.size(); ++k) {
-        MBSLAM_LOG(DEBUG) << log_name_ << " init frame " << frame.frame_index << ": motion " << k << " of " << ids.size()
-                          << " tracks: " << groups[k].count << " inliers, coverage " << groups[k].coverage
-                          << ", in hulls " << groups[k].hull_share;
+        MBSLAM_LOG(DEBUG) << log_name_ << " init frame " << frame.frame_index << ": motion " << k
+                          << " of " << ids.size() << " tracks: " << groups[k].count
+                          << " inliers, coverage " << groups[k].coverage << ", in hulls "
+                          << groups[k].hull_share;
       }
     }
     if (g < 0) {
@@ -828,11 +837,12 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
       all[0].inliers.assign(ids.size(), 1);
       all[0].count = static_cast<int>(ids.size());
       ScoreMotionGroups(xn, all_xy, {}, kInitGridCols, kInitGridRows, &all);
-      MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": no broad static motion among "
-                        << groups.size() << " (largest: " << (groups.empty() ? 0 : groups[0].count)
-                        << " inliers, coverage " << (groups.empty() ? 0.0 : groups[0].coverage) << ", in hulls "
-                        << (groups.empty() ? 0.0 : groups[0].hull_share) << "); shared tracks cover "
-                        << all[0].coverage;
+      MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index
+                        << ": no broad static motion among " << groups.size()
+                        << " (largest: " << (groups.empty() ? 0 : groups[0].count)
+                        << " inliers, coverage " << (groups.empty() ? 0.0 : groups[0].coverage)
+                        << ", in hulls " << (groups.empty() ? 0.0 : groups[0].hull_share)
+                        << "); shared tracks cover " << all[0].coverage;
       if (all[0].coverage < options_.init_min_coverage) set_reference();
       out->state = state_;
       return InitAttempt::kRefusedTracks;
@@ -842,9 +852,10 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     // the map, and the other motions' tracks are kept out of both views.
     if (g > 0) {
       const InitMotionGroup& chosen = groups[static_cast<size_t>(g)];
-      MBSLAM_LOG(INFO) << log_name_ << " init at frame " << frame.frame_index << ": motion " << g << " (" << chosen.count
-                       << " inliers, coverage " << chosen.coverage << ") is the static world, not the largest ("
-                       << groups[0].count << " inliers, coverage " << groups[0].coverage << ")";
+      MBSLAM_LOG(INFO) << log_name_ << " init at frame " << frame.frame_index << ": motion " << g
+                       << " (" << chosen.count << " inliers, coverage " << chosen.coverage
+                       << ") is the static world, not the largest (" << groups[0].count
+                       << " inliers, coverage " << groups[0].coverage << ")";
       std::vector<int64_t> ids_g;
       std::vector<Eigen::Vector2d> xr_g, xn_g;
       for (size_t i = 0; i < ids.size(); ++i) {
@@ -877,7 +888,8 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
   std::vector<Candidate> candidates;
   const EssentialFit fit = FitEssential(xr, xn, thresh);
   if (!fit.ok()) {
-    MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": no essential matrix";
+    MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index
+                      << ": no essential matrix";
     return InitAttempt::kRefusedGeometry;
   }
   const std::vector<cv::Point2d>& pr = fit.pr;
@@ -903,8 +915,9 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
       for (size_t i = 0; i < n; ++i) mask.at<uint8_t>(static_cast<int>(i)) = kt->inliers[i];
       for (double sign : {1.0, -1.0}) candidates.push_back(Candidate{Rigid3d(R, sign * kt->t_unit), mask});
     }
-    MBSLAM_LOG(DEBUG) << log_name_ << " init frame " << frame.frame_index << ": known rotation explains "
-                      << (kt ? kt->count : 0) << " of the essential matrix's " << e_inl << " inliers"
+    MBSLAM_LOG(DEBUG) << log_name_ << " init frame " << frame.frame_index
+                      << ": known rotation explains " << (kt ? kt->count : 0)
+                      << " of the essential matrix's " << e_inl << " inliers"
                       << (rotation_prior_active_ ? "" : ": the body turns, no rotation prior");
   }
   if (!rotation_prior_active_) {
@@ -921,8 +934,9 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
       // (measured as it is on the simulated scenes, TartanAir and DAVIS).
       const int in_front = cv::recoverPose(E.rowRange(0, 3), pr, pn, R, t, 1.0, cv::Point2d(0, 0), mask);
       if (in_front < options_.init_min_points) {
-        MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": E inliers " << e_inl
-                          << ", H inliers " << h_inl << ", " << in_front << " in front of both views within 50 baselines";
+        MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index
+                          << ": E inliers " << e_inl << ", H inliers " << h_inl << ", " << in_front
+                          << " in front of both views within 50 baselines";
         return InitAttempt::kRefusedParallax;
       }
       Eigen::Matrix3d Re;
@@ -972,8 +986,9 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
   }
   if (!best || static_cast<int>(best->points.size()) < options_.init_min_points ||
       best->median_parallax < options_.init_min_parallax_deg * kDeg) {
-    MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": E inliers " << e_inl
-                      << ", H inliers " << h_inl << (planar ? " (planar)" : "") << ", points "
+    MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index
+                      << ": E inliers " << e_inl << ", H inliers " << h_inl
+                      << (planar ? " (planar)" : "") << ", points "
                       << (best ? best->points.size() : 0) << ", median parallax "
                       << (best ? best->median_parallax / kDeg : 0.0) << " deg";
     // Refused for now; more parallax will come (or the reference is replaced). Too few
@@ -1001,9 +1016,9 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
                       /*require_majority=*/false);
     map_coverage = mapped[0].coverage;
     if (SelectStaticGroup(mapped, options_.init_min_coverage, options_.init_max_hull_share) < 0) {
-      MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": the " << best->points.size()
-                        << " points with parallax cover " << map_coverage << " of the image, "
-                        << mapped[0].hull_share << " inside moving hulls";
+      MBSLAM_LOG(DEBUG) << log_name_ << " init refused at frame " << frame.frame_index << ": the "
+                        << best->points.size() << " points with parallax cover " << map_coverage
+                        << " of the image, " << mapped[0].hull_share << " inside moving hulls";
       return InitAttempt::kRefusedTracks;
     }
   }
@@ -1050,8 +1065,9 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
     }
     if (waited < options_.init_wait_frames && reachable &&
         shared >= options_.init_wait_keep_ratio * init_pending_tracks_) {
-      MBSLAM_LOG(DEBUG) << log_name_ << " init at frame " << frame.frame_index << " deferred: median parallax "
-                        << best->median_parallax / kDeg << " deg, " << shared << " of " << init_pending_tracks_
+      MBSLAM_LOG(DEBUG) << log_name_ << " init at frame " << frame.frame_index
+                        << " deferred: median parallax " << best->median_parallax / kDeg << " deg, "
+                        << shared << " of " << init_pending_tracks_
                         << " tracks shared (acceptable since frame " << init_pending_frame_ << ")";
       if (!options_.init_keep_best_pair || !init_pending_pair_ ||
           pair.median_parallax_rad >= init_pending_pair_->median_parallax_rad) {
@@ -1153,9 +1169,10 @@ void SlamSystem::BuildInitialMap(const InitPair& pair, SlamPose* out) {
   tracked_points_at_keyframe_ = static_cast<int>(map_.num_points());
   state_ = options_.init_confirm_frames > 0 ? SlamState::kConfirming : SlamState::kTracking;
   confirm_count_ = 0;
-  MBSLAM_LOG(INFO) << log_name_ << ": initialised from frames " << pair.ref_frame << "-" << pair.frame_index << " with "
-                   << map_.num_points() << " points (" << (pair.planar ? "homography" : "essential")
-                   << ", median parallax " << pair.median_parallax_rad / kDeg << " deg, coverage " << pair.coverage
+  MBSLAM_LOG(INFO) << log_name_ << ": initialised from frames " << pair.ref_frame << "-"
+                   << pair.frame_index << " with " << map_.num_points() << " points ("
+                   << (pair.planar ? "homography" : "essential") << ", median parallax "
+                   << pair.median_parallax_rad / kDeg << " deg, coverage " << pair.coverage
                    << (metric_ ? ", metric scale from odometry" : "") << ")";
   out->state = state_;
   out->valid = state_ == SlamState::kTracking;
@@ -1202,8 +1219,8 @@ void SlamSystem::ApplyBridge(int64_t ref_frame, int64_t cur_frame) {
     pose.cam_from_world.translation *= scale;
     pose.cam_from_world = pose.cam_from_world * old_from_new.Inverse();
   }
-  MBSLAM_LOG(INFO) << log_name_ << ": new map continues the previous world frame (gap of " << ref_frame - b.frame
-                   << " frames, scale x" << scale << ")";
+  MBSLAM_LOG(INFO) << log_name_ << ": new map continues the previous world frame (gap of "
+                   << ref_frame - b.frame << " frames, scale x" << scale << ")";
 }
 
 bool SlamSystem::NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const {
@@ -1266,9 +1283,9 @@ bool SlamSystem::RotationPriorHolds(const SlamFrame& frame, const std::unordered
       (frame.rotation_prior->cam_from_ref * ref->rotation_prior->cam_from_ref.conjugate()).toRotationMatrix();
   const std::optional<KnownRotationTranslation> kt = TranslationGivenRotation(xr, xn, R, thresh, 200);
   const int known = kt ? kt->count : 0;
-  MBSLAM_LOG(DEBUG) << log_name_ << " keyframe at frame " << frame.frame_index << ": from frame " << ref->frame_index
-                    << " the known rotation explains " << known << " of the essential matrix's " << e_inl
-                    << " inliers";
+  MBSLAM_LOG(DEBUG) << log_name_ << " keyframe at frame " << frame.frame_index << ": from frame "
+                    << ref->frame_index << " the known rotation explains " << known
+                    << " of the essential matrix's " << e_inl << " inliers";
   return RotationPriorStillHolds(known, e_inl, options_.rotation_prior_keep_inlier_ratio);
 }
 
@@ -1365,10 +1382,12 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
     update->new_point_ids.push_back(new_pid);
   }
   tracked_points_at_keyframe_ = tracked + static_cast<int>(update->new_point_ids.size());
-  MBSLAM_LOG(DEBUG) << log_name_ << " keyframe at image " << frame.frame_index << ": " << k.track_xy.size() << " static tracks, "
-                    << tracked << " on points, " << update->new_point_ids.size() << " new points; not triangulated: "
-                    << unseen << " unseen by the last keyframes, " << degenerate << " degenerate, " << low_parallax
-                    << " low parallax, " << reprojection << " reprojection, " << released << " released before";
+  MBSLAM_LOG(DEBUG) << log_name_ << " keyframe at image " << frame.frame_index << ": "
+                    << k.track_xy.size() << " static tracks, " << tracked << " on points, "
+                    << update->new_point_ids.size() << " new points; not triangulated: " << unseen
+                    << " unseen by the last keyframes, " << degenerate << " degenerate, "
+                    << low_parallax << " low parallax, " << reprojection << " reprojection, "
+                    << released << " released before";
   last_keyframe_frame_ = frame.frame_index;
   update->new_keyframe = true;
   update->culled_points = CullKeyframes(frame.frame_index);
@@ -1405,7 +1424,8 @@ std::optional<double> SlamSystem::EstablishMetricScale() {
     pose.covariance.bottomLeftCorner<3, 3>() *= s;
   }
   metric_ = true;
-  MBSLAM_LOG(INFO) << log_name_ << ": metric scale from odometry (x" << s << " over a " << odo << " m baseline)";
+  MBSLAM_LOG(INFO) << log_name_ << ": metric scale from odometry (x" << s << " over a " << odo
+                   << " m baseline)";
   return s;
 }
 
