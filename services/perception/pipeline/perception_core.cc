@@ -271,6 +271,7 @@ void PerceptionCore::UpdateGroundPlane() {
     return;
   }
   ground_ = estimate.plane;
+  slam_.SetGroundPlane(ground_->ToVector4());
   MBSLAM_LOG(DEBUG) << "ground plane: n " << estimate.plane.normal.transpose() << " d " << estimate.plane.offset
                     << ", inliers " << estimate.num_inliers << " (" << estimate.inlier_ratio << "), rms " << estimate.rms
                     << ", camera height " << estimate.plane.Height(camera) << (along_path ? ", parallel to the path" : "");

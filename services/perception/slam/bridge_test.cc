@@ -125,5 +125,43 @@ TEST(SlamBridge, ObjectMapsKeepTheSpeedBridgeTheirOwnLossDelayAndNoAssistedPoses
   EXPECT_FALSE(s.hybrid_tracking);
 }
 
+// The ground under a camera tilted by 20 deg: 200 ground points 1.5 m below it (1 %
+// noise), a table top at 0.8 m (100), a wall spanning every height (100) and 5 stray
+// points under the ground. The ground's height is the lowest that holds enough points.
+TEST(SlamBridge, CameraHeightAboveTheGround) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Vector3d up = tilt * Eigen::Vector3d(0.0, -1.0, 0.0);  // camera y points down
+  const auto at = [&](double height, double x, double z) -> Eigen::Vector3d {
+    return tilt * Eigen::Vector3d(x, height, z);
+  };
+  std::vector<Eigen::Vector3d> wall, all;
+  for (int i = 0; i < 100; ++i) wall.push_back(at(1.2 * u(rng) + 0.2, 3.0 * u(rng), 6.0));
+  all = wall;
+  for (int i = 0; i < 200; ++i)
+    all.push_back(at(1.5 * (1.0 + noise(rng)), 3.0 * u(rng), 4.0 + 3.0 * u(rng)));
+  for (int i = 0; i < 100; ++i)
+    all.push_back(at(0.8 * (1.0 + noise(rng)), 0.5 * u(rng), 2.5 + 0.3 * u(rng)));
+  for (int i = 0; i < 5; ++i) all.push_back(at(3.0 + 0.01 * i, u(rng), 5.0));
+  const std::optional<double> h = CameraHeightAboveGround(all, up, 0.05, 15, 0.2);
+  ASSERT_TRUE(h.has_value());
+  EXPECT_NEAR(*h, 1.5, 0.015);
+  // Without the ground the table top is taken: the height is that of the lowest surface
+  // with enough points (a map that sees no floor gives a wrong height).
+  std::vector<Eigen::Vector3d> no_ground = wall;
+  for (size_t i = 300; i < all.size(); ++i) no_ground.push_back(all[i]);
+  const std::optional<double> table = CameraHeightAboveGround(no_ground, up, 0.05, 15, 0.2);
+  ASSERT_TRUE(table.has_value());
+  EXPECT_NEAR(*table, 0.8, 0.01);
+  // A wall alone has no height where enough points gather; nor have too few points.
+  EXPECT_FALSE(CameraHeightAboveGround(wall, up, 0.05, 15, 0.2).has_value());
+  EXPECT_FALSE(
+      CameraHeightAboveGround(std::vector<Eigen::Vector3d>(all.begin() + 100, all.begin() + 110),
+                              up, 0.05, 15, 0.2)
+          .has_value());
+}
+
 }  // namespace
 }  // namespace mbslam

@@ -1,5 +1,6 @@
 #include "services/perception/slam/pose_estimator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -348,6 +349,91 @@ HybridPoseEstimate EstimatePoseWithEpipolar(const std::vector<Eigen::Vector3d>& 
   Eigen::FullPivLU<Matrix6d> lu(info);
   pose.covariance = lu.isInvertible() ? Matrix6d(sigma0 * sigma0 * lu.inverse()) : Matrix6d(Matrix6d::Identity());
   pose.ok = T.IsFinite() && out.num_link_inliers >= 8 && lu.isInvertible();
+  return out;
+}
+
+GroundLengthEstimate GroundLengthOfMotion(const EpipolarLinks& links,
+                                          const std::vector<uint8_t>& use,
+                                          const Eigen::Vector4d& plane, const Rigid3d& length_ref,
+                                          const Rigid3d& cam_from_world, double focal_px,
+                                          double min_elevation_rad, double max_error_px,
+                                          double length_step) {
+  GroundLengthEstimate out;
+  const Eigen::Vector3d n = plane.head<3>();
+  if (!(std::abs(n.norm() - 1.0) < 1e-6) || !std::isfinite(plane[3]) || !(focal_px > 0.0))
+    return out;
+  const Eigen::Vector3d c0 = length_ref.Inverse().translation;
+  const Rigid3d world_from_cam = cam_from_world.Inverse();
+  const Eigen::Vector3d motion = world_from_cam.translation - c0;
+  if (!(motion.norm() > 1e-12)) return out;
+  const Eigen::Vector3d u = motion.normalized();
+  const double sin_min = std::sin(min_elevation_rad);
+  // Each candidate: its ground point and its current ray (world); the length that
+  // brings the point closest to the ray.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> xy_cur;
+  std::vector<double> lengths;
+  for (size_t i = 0; i < links.xy_ref.size(); ++i) {
+    if (!use.empty() && !use[i]) continue;
+    const Rigid3d ref_from_cam = links.references[links.reference[i]].Inverse();  // world_from_ref
+    const Eigen::Vector3d c = ref_from_cam.translation;
+    const Eigen::Vector3d a = ref_from_cam.rotation * links.xy_ref[i].homogeneous();
+    const double height = n.dot(c) + plane[3];
+    const double nd = n.dot(a);
+    if (!(height > 0.0) || !(-nd >= sin_min * a.norm()))
+      continue;  // above the ground, ray below its horizon
+    const Eigen::Vector3d X = c + (height / -nd) * a;
+    const Eigen::Vector3d b = world_from_cam.rotation * links.xy_cur[i].homogeneous();
+    // X - c0 = L u + m b in the least-squares sense.
+    Eigen::Matrix<double, 3, 2> A;
+    A << u, b;
+    const Eigen::Matrix2d AtA = A.transpose() * A;
+    if (std::abs(AtA.determinant()) < 1e-12 * AtA.trace() * AtA.trace())
+      continue;  // ray along the motion
+    const Eigen::Vector2d lm = AtA.ldlt().solve(A.transpose() * (X - c0));
+    if (!(lm[1] > 0.0) || !(lm[0] > 0.0) || !std::isfinite(lm[0])) continue;
+    points.push_back(X);
+    xy_cur.push_back(links.xy_cur[i]);
+    lengths.push_back(lm[0]);
+  }
+  out.candidates = static_cast<int>(points.size());
+  if (points.empty()) return out;
+  const Eigen::Matrix3d R = cam_from_world.RotationMatrix();
+  const double max_error = max_error_px / focal_px;
+  // Agreement at a length: the points projected within max_error of their tracks.
+  const auto agreeing = [&](double L, std::vector<size_t>* which) {
+    const Eigen::Vector3d centre = c0 + L * u;
+    double cost = 0.0;
+    if (which) which->clear();
+    for (size_t j = 0; j < points.size(); ++j) {
+      const Eigen::Vector3d p = R * (points[j] - centre);
+      double e = max_error;
+      if (p.z() > 0.0) e = std::min(max_error, (p.head<2>() / p.z() - xy_cur[j]).norm());
+      cost += e;
+      if (e < max_error && which) which->push_back(j);
+    }
+    return cost;  // MSAC: a truncated sum, smaller is better
+  };
+  double best_cost = std::numeric_limits<double>::infinity();
+  double best_length = 0.0;
+  for (double L : lengths) {
+    const double cost = agreeing(L, nullptr);
+    if (cost < best_cost) {
+      best_cost = cost;
+      best_length = L;
+    }
+  }
+  // The truncated L1 cost is least at (about) a candidate: the length is the best one
+  // (an average of the agreeing lengths would take in the walls' near the ground).
+  std::vector<size_t> support;
+  agreeing(best_length, &support);
+  out.length = best_length;
+  out.support = static_cast<int>(support.size());
+  agreeing((1.0 - length_step) * best_length, &support);
+  out.support_shorter = static_cast<int>(support.size());
+  agreeing((1.0 + length_step) * best_length, &support);
+  out.support_longer = static_cast<int>(support.size());
+  out.ok = out.support > 0;
   return out;
 }
 

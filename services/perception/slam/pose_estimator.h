@@ -115,6 +115,34 @@ HybridPoseEstimate EstimatePoseWithEpipolar(const std::vector<Eigen::Vector3d>& 
                                             double expected_length, double length_sigma_ratio, double focal_px,
                                             const PoseEstimatorOptions& options);
 
+struct GroundLengthEstimate {
+  bool ok = false;      // a length was found (support >= 1)
+  double length = 0.0;  // of the motion since length_ref (map units)
+  int support = 0;      // links it projects onto their tracks (count)
+  int candidates = 0;   // links whose reference ray meets the ground (count)
+  // ... the links agreeing at (1 -+ length_step) * length: when these are as many, the
+  // views do not tell the length (too little parallax, or no ground in view).
+  int support_shorter = 0;
+  int support_longer = 0;
+};
+
+// The ground plane's cue to the length of a motion whose rotation and direction are
+// known (thesis sec. 5.1.1): a link whose reference ray meets the ground `plane`
+// ([unit normal pointing up; offset], world) at least min_elevation_rad below the horizon
+// is, if it lies on the ground, at that point; the camera centre moves from
+// `length_ref`'s (cam_from_world) along the direction of `cam_from_world`'s, and each such
+// link gives the length that brings its point closest to its current ray. The length
+// returned is the one of these with the least sum of reprojection errors truncated at
+// max_error_px (MSAC on the error, not its square): the ground's links agree on it, walls
+// and furniture give scattered lengths. Only links with use[i] != 0 count (all if `use`
+// is empty).
+GroundLengthEstimate GroundLengthOfMotion(const EpipolarLinks& links,
+                                          const std::vector<uint8_t>& use,
+                                          const Eigen::Vector4d& plane, const Rigid3d& length_ref,
+                                          const Rigid3d& cam_from_world, double focal_px,
+                                          double min_elevation_rad, double max_error_px,
+                                          double length_step);
+
 }  // namespace mbslam
 
 #endif  // MBSLAM_SERVICES_PERCEPTION_SLAM_POSE_ESTIMATOR_H_

@@ -109,6 +109,47 @@ void SlamSystem::Reset() {
   posed_xy_.clear();
   hybrid_frames_ = 0;
   released_tracks_.clear();
+  ground_plane_.reset();
+}
+
+std::optional<double> CameraHeightAboveGround(const std::vector<Eigen::Vector3d>& points_in_cam,
+                                              const Eigen::Vector3d& up_in_cam, double band,
+                                              int min_points, double min_share) {
+  std::vector<double> below;  // heights of the points below the camera
+  for (const Eigen::Vector3d& p : points_in_cam) {
+    const double h = -up_in_cam.dot(p);
+    if (h > 0.0 && std::isfinite(h)) below.push_back(h);
+  }
+  std::sort(below.begin(), below.end());
+  std::optional<double> best;
+  const double need =
+      std::max(static_cast<double>(min_points), min_share * static_cast<double>(below.size()));
+  for (size_t i = 0; i < below.size(); ++i) {
+    // Points within band * h of h = below[i] (sorted: a window).
+    const double h = below[i];
+    const auto lo = std::lower_bound(below.begin(), below.end(), h * (1.0 - band));
+    const auto hi = std::upper_bound(below.begin(), below.end(), h * (1.0 + band));
+    if (static_cast<double>(hi - lo) >= need) best = h;  // the lowest (largest height) wins
+  }
+  if (!best) return std::nullopt;
+  // The mean height of the points around it.
+  const auto lo = std::lower_bound(below.begin(), below.end(), *best * (1.0 - band));
+  const auto hi = std::upper_bound(below.begin(), below.end(), *best * (1.0 + band));
+  double sum = 0.0;
+  for (auto it = lo; it != hi; ++it) sum += *it;
+  return sum / static_cast<double>(hi - lo);
+}
+
+bool GroundLengthIsUsable(const GroundLengthEstimate& g, const SlamOptions& options) {
+  return g.ok && g.support >= options.hybrid_ground_min_links &&
+         g.support >= options.hybrid_ground_min_share * static_cast<double>(g.candidates) &&
+         std::max(g.support_shorter, g.support_longer) <=
+             options.hybrid_ground_step_max_support * static_cast<double>(g.support);
+}
+
+void SlamSystem::SetGroundPlane(const Eigen::Vector4d& plane) {
+  if (!plane.allFinite() || !(std::abs(plane.head<3>().norm() - 1.0) < 1e-6)) return;
+  ground_plane_ = plane;
 }
 
 void SlamSystem::RestartMap(std::optional<Bridge> bridge) {
@@ -556,6 +597,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
             }
             if (depths.size() >= 8) b.median_depth = Median(depths);
           }
+          if (options_.bridge_ground) b.ground = ground_plane_;
           bridge = b;
         }
         RestartMap(bridge);
@@ -642,9 +684,34 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
   const double expected_length = hybrid_speed_ >= 0.0
                                      ? hybrid_speed_ * static_cast<double>(frame.frame_index - ref_frames.back())
                                      : (prior * length_ref.Inverse()).translation.norm();
-  const HybridPoseEstimate h =
-      EstimatePoseWithEpipolar(X, xy, links, prior, start_reference, length_reference, expected_length,
-                               options_.hybrid_length_sigma, frame.focal_px, options_.pose);
+  HybridPoseEstimate h = EstimatePoseWithEpipolar(
+      X, xy, links, prior, start_reference, length_reference, expected_length,
+      options_.hybrid_length_sigma, frame.focal_px, options_.pose);
+  // The ground's length, along the direction just estimated, when enough links agree on it.
+  if (options_.hybrid_ground_length && ground_plane_ && h.pose.ok) {
+    const GroundLengthEstimate g = GroundLengthOfMotion(
+        links, h.link_inliers, *ground_plane_, length_ref, h.pose.cam_from_world, frame.focal_px,
+        options_.hybrid_ground_min_elevation_deg * kDeg, options_.hybrid_ground_max_error_px,
+        options_.hybrid_ground_length_step);
+    const bool use = GroundLengthIsUsable(g, options_);
+    MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": ground length "
+                      << g.length << " (held speed's " << expected_length << "), " << g.support
+                      << " of " << g.candidates << " ground links agree (" << g.support_shorter
+                      << " / " << g.support_longer << " at -+" << options_.hybrid_ground_length_step
+                      << ")" << (use ? "" : ": not used");
+    if (use) {
+      HybridPoseEstimate hg = EstimatePoseWithEpipolar(
+          X, xy, links, prior, start_reference, length_reference, g.length,
+          options_.hybrid_ground_length_sigma, frame.focal_px, options_.pose);
+      if (hg.pose.ok) {
+        h = std::move(hg);
+        // The run's later images hold this speed instead.
+        if (hybrid_speed_ >= 0.0 && frame.frame_index > ref_frames.back()) {
+          hybrid_speed_ = g.length / static_cast<double>(frame.frame_index - ref_frames.back());
+        }
+      }
+    }
+  }
   const bool ok = h.pose.ok && h.num_link_inliers >= options_.hybrid_min_links &&
                   h.num_link_inliers >= options_.hybrid_min_link_ratio * static_cast<double>(links.xy_ref.size());
   MBSLAM_LOG(DEBUG) << log_name_ << " frame " << frame.frame_index << ": epipolar-assisted pose, "
@@ -1208,6 +1275,24 @@ void SlamSystem::ApplyBridge(int64_t ref_frame, int64_t cur_frame) {
       }
       if (depths.size() >= 8) scale = b.median_depth / Median(depths);
     }
+    if (b.ground) {
+      // The old plane's normal in the reference view (the new world frame), and the
+      // reference camera's height above the old plane (old units).
+      const Eigen::Vector3d up_ref = ref_in_old.rotation * b.ground->head<3>();
+      const double old_height =
+          b.ground->head<3>().dot(ref_in_old.Inverse().translation) + (*b.ground)[3];
+      std::vector<Eigen::Vector3d> points;
+      for (const auto& [id, p] : map_.points()) points.push_back(p.position);
+      const std::optional<double> new_height = CameraHeightAboveGround(
+          points, up_ref, options_.bridge_ground_band, options_.bridge_ground_min_points,
+          options_.bridge_ground_min_share);
+      MBSLAM_LOG(INFO) << log_name_ << ": bridge: camera height above the ground " << old_height
+                       << " (old units), "
+                       << (new_height ? std::to_string(*new_height) : std::string("no ground"))
+                       << " (new units)"
+                       << " against scale x" << scale;
+      if (new_height && old_height > 0.0) scale = old_height / *new_height;
+    }
     metric_ = b.metric;
   }
   // X_old = ref_in_old^-1 * (scale * X_new): the new world frame is the reference camera.
@@ -1411,6 +1496,7 @@ std::optional<double> SlamSystem::EstablishMetricScale() {
   MergeBundleAdjustment(true);
   const double s = odo / slam;
   map_.Rescale(s);
+  if (ground_plane_) (*ground_plane_)[3] *= s;
   for (TrajectoryEntry& e : trajectory_) {
     e.cam_from_world.translation *= s;
     e.cam_from_anchor.translation *= s;
