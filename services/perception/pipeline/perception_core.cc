@@ -673,6 +673,9 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     ba_timer_->Add(slam_.last_ba_seconds() * 1e3);
   }
   if (map_update.culled_points > 0) counters_->Increment(counter::kMapPointsCulled, map_update.culled_points);
+  // The metric rescale comes with a new keyframe: the plane is rescaled first, so that a
+  // fit in the new units is not rescaled again (it was, before).
+  if (map_update.rescaled_by && ground_) ground_->Rescale(*map_update.rescaled_by);
   if (map_update.new_keyframe) UpdateGroundPlane();
   {
     // This image's moving objects, and those predicted for it: no static evidence there.
@@ -691,7 +694,6 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     }
     UpdateOccupancy(map_update, frame.utime, 0.5 * (intrinsics.fx + intrinsics.fy), moving_hulls_xy, &result);
   }
-  if (map_update.rescaled_by && ground_) ground_->Rescale(*map_update.rescaled_by);
   FillCameraPose(slam_pose, &result.camera_pose);
   for (const auto& [f, cam_from_world] : slam_pose.backfilled) {
     auto u = frame_utime_.find(f);

@@ -261,6 +261,9 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   // runs out, not the texture (with them, sim-multi's longest object map: trajectory
   // 4.6 -> 10.8 %, shape 53 -> 646 % of its size).
   s.hybrid_tracking = false;
+  // An object's map has no ground plane (nothing gives it one); said, not left implicit.
+  s.hybrid_ground_length = false;
+  s.bridge_ground = false;
   s.released_tracks_stay_unmapped = options.released_tracks_stay_unmapped;
   s.max_keyframes = options.max_keyframes;
   s.keyframe_max_frames = std::max(options.keyframe_max_frames, s.keyframe_min_frames);

@@ -359,6 +359,14 @@ GroundLengthEstimate GroundLengthOfMotion(const EpipolarLinks& links,
                                           double min_elevation_rad, double max_error_px,
                                           double length_step) {
   GroundLengthEstimate out;
+  const size_t n_links = links.xy_ref.size();
+  if (links.xy_cur.size() != n_links || links.reference.size() != n_links ||
+      (!use.empty() && use.size() != n_links)) {
+    return out;
+  }
+  for (int r : links.reference) {
+    if (r < 0 || r >= static_cast<int>(links.references.size())) return out;
+  }
   const Eigen::Vector3d n = plane.head<3>();
   if (!(std::abs(n.norm() - 1.0) < 1e-6) || !std::isfinite(plane[3]) || !(focal_px > 0.0))
     return out;
@@ -375,9 +383,10 @@ GroundLengthEstimate GroundLengthOfMotion(const EpipolarLinks& links,
   std::vector<double> lengths;
   for (size_t i = 0; i < links.xy_ref.size(); ++i) {
     if (!use.empty() && !use[i]) continue;
-    const Rigid3d ref_from_cam = links.references[links.reference[i]].Inverse();  // world_from_ref
-    const Eigen::Vector3d c = ref_from_cam.translation;
-    const Eigen::Vector3d a = ref_from_cam.rotation * links.xy_ref[i].homogeneous();
+    const Rigid3d world_from_ref =
+        links.references[links.reference[i]].Inverse();  // world_from_ref
+    const Eigen::Vector3d c = world_from_ref.translation;
+    const Eigen::Vector3d a = world_from_ref.rotation * links.xy_ref[i].homogeneous();
     const double height = n.dot(c) + plane[3];
     const double nd = n.dot(a);
     if (!(height > 0.0) || !(-nd >= sin_min * a.norm()))
@@ -424,7 +433,7 @@ GroundLengthEstimate GroundLengthOfMotion(const EpipolarLinks& links,
     }
   }
   // The truncated L1 cost is least at (about) a candidate: the length is the best one
-  // (an average of the agreeing lengths would take in the walls' near the ground).
+  // (an average of the agreeing lengths would take in those of wall points near the ground).
   std::vector<size_t> support;
   agreeing(best_length, &support);
   out.length = best_length;

@@ -135,7 +135,7 @@ struct GroundLengthEstimate {
 // returned is the one of these with the least sum of reprojection errors truncated at
 // max_error_px (MSAC on the error, not its square): the ground's links agree on it, walls
 // and furniture give scattered lengths. Only links with use[i] != 0 count (all if `use`
-// is empty).
+// is empty). Links of mismatched sizes or references out of range: not ok.
 GroundLengthEstimate GroundLengthOfMotion(const EpipolarLinks& links,
                                           const std::vector<uint8_t>& use,
                                           const Eigen::Vector4d& plane, const Rigid3d& length_ref,

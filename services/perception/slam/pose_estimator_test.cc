@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 
 namespace mbslam {
@@ -323,6 +324,48 @@ TEST(PoseEstimator, GroundLengthWithNoiseAndWithoutGround) {
                                     s.truth, 320.0, 0.1, 1.5, 0.2)
                    .ok);
   EXPECT_FALSE(GroundLengthOfMotion(s.links, {}, ground, s.ref, s.ref, 320.0, 0.1, 1.5, 0.2).ok);
+}
+
+TEST(PoseEstimator, GroundLengthIsUsableAtEachThreshold) {
+  const SlamOptions o;  // 8 links, 0.3 of the candidates, at most 0.75 as many at -+20 %
+  GroundLengthEstimate g;
+  g.ok = true;
+  g.support = 10;
+  g.candidates = 30;
+  g.support_shorter = 7;
+  g.support_longer = 2;
+  EXPECT_TRUE(GroundLengthIsUsable(g, o));
+  const auto with = [&](const std::function<void(GroundLengthEstimate*)>& change) {
+    GroundLengthEstimate x = g;
+    change(&x);
+    return GroundLengthIsUsable(x, o);
+  };
+  EXPECT_FALSE(with([](GroundLengthEstimate* x) { x->ok = false; }));
+  EXPECT_FALSE(with([](GroundLengthEstimate* x) {
+    x->support = 7, x->support_shorter = 2, x->candidates = 20;
+  }));  // under 8
+  EXPECT_TRUE(with(
+      [](GroundLengthEstimate* x) { x->support = 8, x->support_shorter = 2, x->candidates = 20; }));
+  EXPECT_FALSE(with([](GroundLengthEstimate* x) { x->candidates = 34; }));  // 10 < 0.3 * 34
+  EXPECT_TRUE(with([](GroundLengthEstimate* x) { x->candidates = 33; }));
+  EXPECT_FALSE(with([](GroundLengthEstimate* x) { x->support_longer = 8; }));  // 8 > 0.75 * 10
+  EXPECT_FALSE(with([](GroundLengthEstimate* x) { x->support_shorter = 8; }));
+}
+
+TEST(PoseEstimator, GroundLengthRefusesMismatchedLinks) {
+  const Eigen::Vector4d ground(0.0, 0.0, 1.0, 0.0);
+  const GroundScene s = MakeGroundScene(1, 0.0, 60);
+  const Rigid3d half = WithLengthShare(s.truth, s.ref, 0.5);
+  ASSERT_TRUE(GroundLengthOfMotion(s.links, {}, ground, s.ref, half, 320.0, 0.1, 1.5, 0.2).ok);
+  EpipolarLinks short_cur = s.links;
+  short_cur.xy_cur.pop_back();
+  EXPECT_FALSE(GroundLengthOfMotion(short_cur, {}, ground, s.ref, half, 320.0, 0.1, 1.5, 0.2).ok);
+  EpipolarLinks bad_ref = s.links;
+  bad_ref.reference[3] = 1;  // one reference only
+  EXPECT_FALSE(GroundLengthOfMotion(bad_ref, {}, ground, s.ref, half, 320.0, 0.1, 1.5, 0.2).ok);
+  const std::vector<uint8_t> short_use(s.links.xy_ref.size() - 1, 1);
+  EXPECT_FALSE(
+      GroundLengthOfMotion(s.links, short_use, ground, s.ref, half, 320.0, 0.1, 1.5, 0.2).ok);
 }
 
 }  // namespace

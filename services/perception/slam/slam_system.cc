@@ -121,23 +121,33 @@ std::optional<double> CameraHeightAboveGround(const std::vector<Eigen::Vector3d>
     if (h > 0.0 && std::isfinite(h)) below.push_back(h);
   }
   std::sort(below.begin(), below.end());
-  std::optional<double> best;
+  const auto window = [&](double h) {
+    return std::make_pair(std::lower_bound(below.begin(), below.end(), h * (1.0 - band)),
+                          std::upper_bound(below.begin(), below.end(), h * (1.0 + band)));
+  };
   const double need =
       std::max(static_cast<double>(min_points), min_share * static_cast<double>(below.size()));
-  for (size_t i = 0; i < below.size(); ++i) {
-    // Points within band * h of h = below[i] (sorted: a window).
-    const double h = below[i];
-    const auto lo = std::lower_bound(below.begin(), below.end(), h * (1.0 - band));
-    const auto hi = std::upper_bound(below.begin(), below.end(), h * (1.0 + band));
-    if (static_cast<double>(hi - lo) >= need) best = h;  // the lowest (largest height) wins
+  // The lowest surface: the largest height whose window holds enough points.
+  std::optional<double> start;
+  for (double h : below) {
+    const auto [lo, hi] = window(h);
+    if (static_cast<double>(hi - lo) >= need) start = h;
   }
-  if (!best) return std::nullopt;
-  // The mean height of the points around it.
-  const auto lo = std::lower_bound(below.begin(), below.end(), *best * (1.0 - band));
-  const auto hi = std::upper_bound(below.begin(), below.end(), *best * (1.0 + band));
-  double sum = 0.0;
-  for (auto it = lo; it != hi; ++it) sum += *it;
-  return sum / static_cast<double>(hi - lo);
+  if (!start) return std::nullopt;
+  // That window lies on the far side of the surface's spread: the mean of the points
+  // around the height, repeated until it settles, is its middle.
+  double h = *start;
+  for (int iter = 0; iter < 50; ++iter) {
+    const auto [lo, hi] = window(h);
+    if (lo == hi) break;
+    double sum = 0.0;
+    for (auto it = lo; it != hi; ++it) sum += *it;
+    const double next = sum / static_cast<double>(hi - lo);
+    const bool settled = std::abs(next - h) <= 1e-9 * h;
+    h = next;
+    if (settled) break;
+  }
+  return h;
 }
 
 bool GroundLengthIsUsable(const GroundLengthEstimate& g, const SlamOptions& options) {
@@ -706,7 +716,7 @@ bool SlamSystem::TrackWithEpipolar(const SlamFrame& frame, const std::vector<Eig
       if (hg.pose.ok) {
         h = std::move(hg);
         // The run's later images hold this speed instead.
-        if (hybrid_speed_ >= 0.0 && frame.frame_index > ref_frames.back()) {
+        if (frame.frame_index > ref_frames.back()) {
           hybrid_speed_ = g.length / static_cast<double>(frame.frame_index - ref_frames.back());
         }
       }
@@ -1262,6 +1272,7 @@ void SlamSystem::ApplyBridge(int64_t ref_frame, int64_t cur_frame) {
   // during the gap fools the first (TartanAir: a segment at 0.6x the scale after the
   // camera accelerated 1.6x); an indoor scene's depth changes less.
   double scale = 1.0;
+  bool ground_bridged = false;  // the units keep the camera's height above the old plane
   const Keyframe* k1 = map_.LastKeyframe();
   if (!(b.metric && metric_) && k1 != nullptr) {
     const double predicted = Rigid3d::Exp(b.twist_per_frame).translation.norm() * static_cast<double>(cur_frame - ref_frame);
@@ -1291,7 +1302,10 @@ void SlamSystem::ApplyBridge(int64_t ref_frame, int64_t cur_frame) {
                        << (new_height ? std::to_string(*new_height) : std::string("no ground"))
                        << " (new units)"
                        << " against scale x" << scale;
-      if (new_height && old_height > 0.0) scale = old_height / *new_height;
+      if (new_height && old_height > 0.0) {
+        scale = old_height / *new_height;
+        ground_bridged = true;
+      }
     }
     metric_ = b.metric;
   }
@@ -1304,6 +1318,9 @@ void SlamSystem::ApplyBridge(int64_t ref_frame, int64_t cur_frame) {
     pose.cam_from_world.translation *= scale;
     pose.cam_from_world = pose.cam_from_world * old_from_new.Inverse();
   }
+  // The old plane is the new map's ground too when it set the units (the camera is at the
+  // same height above it); a map dropped before its confirmation drops it again.
+  if (ground_bridged) ground_plane_ = b.ground;
   MBSLAM_LOG(INFO) << log_name_ << ": new map continues the previous world frame (gap of "
                    << ref_frame - b.frame << " frames, scale x" << scale << ")";
 }
