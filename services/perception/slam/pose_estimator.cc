@@ -383,8 +383,7 @@ GroundLengthEstimate GroundLengthOfMotion(const EpipolarLinks& links,
   std::vector<double> lengths;
   for (size_t i = 0; i < links.xy_ref.size(); ++i) {
     if (!use.empty() && !use[i]) continue;
-    const Rigid3d world_from_ref =
-        links.references[links.reference[i]].Inverse();  // world_from_ref
+    const Rigid3d world_from_ref = links.references[links.reference[i]].Inverse();
     const Eigen::Vector3d c = world_from_ref.translation;
     const Eigen::Vector3d a = world_from_ref.rotation * links.xy_ref[i].homogeneous();
     const double height = n.dot(c) + plane[3];
@@ -409,39 +408,37 @@ GroundLengthEstimate GroundLengthOfMotion(const EpipolarLinks& links,
   if (points.empty()) return out;
   const Eigen::Matrix3d R = cam_from_world.RotationMatrix();
   const double max_error = max_error_px / focal_px;
-  // Agreement at a length: the points projected within max_error of their tracks.
-  const auto agreeing = [&](double L, std::vector<size_t>* which) {
+  // At a length: the truncated sum of the points' reprojection errors (MSAC; smaller is
+  // better) and how many project within max_error of their tracks.
+  const auto agreement = [&](double L, int* count) {
     const Eigen::Vector3d centre = c0 + L * u;
     double cost = 0.0;
-    if (which) which->clear();
+    *count = 0;
     for (size_t j = 0; j < points.size(); ++j) {
       const Eigen::Vector3d p = R * (points[j] - centre);
       double e = max_error;
       if (p.z() > 0.0) e = std::min(max_error, (p.head<2>() / p.z() - xy_cur[j]).norm());
       cost += e;
-      if (e < max_error && which) which->push_back(j);
+      *count += e < max_error;
     }
-    return cost;  // MSAC: a truncated sum, smaller is better
+    return cost;
   };
   double best_cost = std::numeric_limits<double>::infinity();
   double best_length = 0.0;
   for (double L : lengths) {
-    const double cost = agreeing(L, nullptr);
+    int count = 0;
+    const double cost = agreement(L, &count);
     if (cost < best_cost) {
       best_cost = cost;
       best_length = L;
+      out.support = count;
     }
   }
   // The truncated L1 cost is least at (about) a candidate: the length is the best one
   // (an average of the agreeing lengths would take in those of wall points near the ground).
-  std::vector<size_t> support;
-  agreeing(best_length, &support);
   out.length = best_length;
-  out.support = static_cast<int>(support.size());
-  agreeing((1.0 - length_step) * best_length, &support);
-  out.support_shorter = static_cast<int>(support.size());
-  agreeing((1.0 + length_step) * best_length, &support);
-  out.support_longer = static_cast<int>(support.size());
+  agreement((1.0 - length_step) * best_length, &out.support_shorter);
+  agreement((1.0 + length_step) * best_length, &out.support_longer);
   out.ok = out.support > 0;
   return out;
 }

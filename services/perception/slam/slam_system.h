@@ -159,8 +159,9 @@ struct SlamOptions {
   // The length of an epipolar-assisted motion from the ground plane (thesis sec. 5.1.1's
   // ground cue, given by SetGroundPlane): a linked track whose reference ray meets the
   // ground below the horizon is, if it lies on the ground, at a known point of the map;
-  // the motion's length along its estimated direction that projects the most such points
-  // onto their tracks (within hybrid_ground_max_error_px; GroundLengthOfMotion) replaces
+  // the motion's length along its estimated direction whose projections of these points
+  // fall nearest their tracks (errors truncated at hybrid_ground_max_error_px;
+  // GroundLengthOfMotion) replaces
   // the held speed's, with its own prior (hybrid_ground_length_sigma), and its speed is
   // held by the run's later images. The held speed misses a camera that speeds up or
   // slows down during a run of such poses: TartanAir from image 32 sped up from 0.07 to
@@ -200,13 +201,13 @@ struct SlamOptions {
   // below the reference view (along the old plane's normal carried over the gap): the new
   // units then make the camera's height above it what it was above the old plane
   // (bridge_ground_min_points of the new points within bridge_ground_band of one height,
-  // at least bridge_ground_min_share of those below the camera; the lowest such height
-  // is the ground). The camera's height changes less across a loss than the depths it sees:
-  // TartanAir from image 32 (RANSAC seed 1) lost its map facing a door, and the depth cue
-  // made the new map's units 0.3x the old (x0.098; the ground x0.188): ATE 2.97 -> 2.38 %.
-  // Ten starts, with hybrid_ground_length, seeds 24301 / 1 / 2 / 3: 0.952 / 1.016 / 0.990
-  // / 0.987 -> 0.952 / 0.957 / 0.932 / 0.929 % (a loss with a ground plane on both sides
-  // happens on starts 32 and 40 only); the other evaluations unchanged.
+  // at least bridge_ground_min_share of those below the camera; the lowest such surface
+  // is the ground, its height the settled mean of those points). The camera's height changes less
+  // across a loss than the depths it sees: TartanAir from image 32 (RANSAC seed 1) lost its map
+  // facing a door, and the depth cue made the new map's units 0.3x the old (x0.098; the ground
+  // x0.188): ATE 2.97 -> 2.38 %. Ten starts, with hybrid_ground_length, seeds 24301 / 1 / 2 / 3:
+  // 0.952 / 1.016 / 0.990 / 0.987 -> 0.952 / 0.957 / 0.932 / 0.929 % (a loss with a ground plane on
+  // both sides happens on starts 32 and 40 only); the other evaluations unchanged.
   bool bridge_ground = true;
   int bridge_ground_min_points = 15;     // (count)
   double bridge_ground_min_share = 0.2;  // of the new points below the camera [0, 1]
@@ -377,8 +378,8 @@ struct SlamOptions {
     v("hybrid_length_sigma", &hybrid_length_sigma,
       "prior on the motion's length since the reference, standard deviation as a share of the predicted one");
     v("hybrid_ground_length", &hybrid_ground_length,
-      "an epipolar-assisted motion's length from the ground plane: the length that puts most "
-      "linked ground tracks on it");
+      "an epipolar-assisted motion's length from the ground plane: the length whose "
+      "projections of the linked ground tracks fall nearest them");
     v("hybrid_ground_min_links", &hybrid_ground_min_links,
       "... links that must agree on that length (count)");
     v("hybrid_ground_min_share", &hybrid_ground_min_share,
