@@ -48,3 +48,18 @@ last_json() {
 json_get() {
   python3 -c 'import json,sys; v=json.loads(sys.argv[1]).get(sys.argv[2]); print("null" if v is None else v)' "$1" "$2"
 }
+
+# tartanair_from START SRC DST [END]: DST holds SRC's images from START on (up to END,
+# exclusive; default all), renumbered from 0 (symbolic links), and their truth lines.
+tartanair_from() {
+  local k="$1" src="$2" dst="$3" end="${4:-}"
+  rm -rf "$dst"
+  mkdir -p "$dst/images"
+  local n i
+  n=$(find "$src/images" -name '*_left.jpg' | wc -l)
+  if [[ -n "$end" && "$end" -lt "$n" ]]; then n="$end"; fi
+  for ((i = k; i < n; i++)); do
+    ln -s "$src/images/$(printf %06d_left.jpg "$i")" "$dst/images/$(printf %06d_left.jpg $((i - k)))"
+  done
+  sed -n "$((k + 1)),${n}p" "$src/pose_left.txt" > "$dst/pose_left.txt"
+}

@@ -41,20 +41,6 @@ done
 out="$MBSLAM_EVAL_OUT"
 mkdir -p "$out"
 
-# tartanair_from START SRC DST: DST holds SRC's images from START on, renumbered from 0
-# (symbolic links), and its truth from the same line.
-tartanair_from() {
-  local k="$1" src="$2" dst="$3"
-  rm -rf "$dst"
-  mkdir -p "$dst/images"
-  local n i
-  n=$(find "$src/images" -name '*_left.jpg' | wc -l)
-  for ((i = k; i < n; i++)); do
-    ln -s "$src/images/$(printf %06d_left.jpg "$i")" "$dst/images/$(printf %06d_left.jpg $((i - k)))"
-  done
-  tail -n +$((k + 1)) "$src/pose_left.txt" > "$dst/pose_left.txt"
-}
-
 # run_one NAME DATA DIR -> prints the JSON object of one replay
 run_one() {
   local name="$1" data="$2" dir="$3" source_kind calib rate truth c1 c2 c3

@@ -80,7 +80,9 @@ Status ComputeAte(const Trajectory& est, const Trajectory& gt, const AteOptions&
     src.push_back(est[p.est].pose.translation);
     dst.push_back(gt[p.gt].pose.translation);
   }
-  if (alignment != Alignment::kNone) {
+  if (options.fixed_gt_from_est) {
+    result->gt_from_est = *options.fixed_gt_from_est;
+  } else if (alignment != Alignment::kNone) {
     const bool with_scale = alignment == Alignment::kSim3;
     const Status st = UmeyamaAlignment(src, dst, with_scale, &result->gt_from_est);
     if (!st.ok()) {

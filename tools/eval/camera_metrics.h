@@ -6,6 +6,7 @@
 // definitions, times in int64 µs).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,10 @@ struct ErrorStats {
 struct AteOptions {
   std::string alignment = "sim3";  // none | se3 | sim3 (sim3 for monocular, up-to-scale estimates)
   int64_t max_time_diff_us = 20000;  // largest time difference of associated poses (µs)
+  // A given alignment (gt_from_est), e.g. one computed on another run in the same map:
+  // used as it is instead of `alignment` (a relocalised run is scored in the frame of
+  // the map it relocalised in). Not an option of the text configuration.
+  std::optional<Sim3d> fixed_gt_from_est;
 
   bool Check() const {
     Alignment a;

@@ -149,6 +149,33 @@ int RunAte(const mbslam::CommandLineArgs& args) {
     return Fail(st.message());
   }
 
+  // --align-est OTHER.tum with --align-gt-log LOG (or --align-gt F.tum): the alignment is
+  // computed on another run (its estimate against its truth) and applied to --est as it
+  // is: a run that relocalised in a map the other run made is scored in that map's frame.
+  std::string alignment_label = options.alignment;
+  if (args.Has("align-est")) {
+    eval::Trajectory other_est, other_gt;
+    st = eval::ReadTumTrajectory(args.Get("align-est"), &other_est);
+    if (st.ok()) {
+      if (args.Has("align-gt-log")) {
+        eval::GroundTruthLog truth;
+        st = eval::ReadGroundTruthLog(args.Get("align-gt-log"),
+                                      args.Get("gt-channel", channels.ground_truth), &truth);
+        other_gt = truth.camera;
+      } else if (args.Has("align-gt")) {
+        st = eval::ReadTumTrajectory(args.Get("align-gt"), &other_gt);
+      } else {
+        st = Status::Error("ate: --align-est needs --align-gt-log LOG or --align-gt FILE.tum");
+      }
+    }
+    eval::AteResult other;
+    if (st.ok()) st = eval::ComputeAte(other_est, other_gt, options, &other);
+    if (!st.ok()) return Fail("ate: alignment from " + args.Get("align-est") + ": " + st.message());
+    options.fixed_gt_from_est = other.gt_from_est;
+    alignment_label = "from " + args.Get("align-est");
+    std::printf("alignment from %s: %zu pairs, ATE there %.6f m\n", args.Get("align-est").c_str(),
+                other.pairs.size(), other.translation.rmse);
+  }
   eval::AteResult ate;
   st = eval::ComputeAte(est, gt, options, &ate);
   if (!st.ok()) {
@@ -165,7 +192,7 @@ int RunAte(const mbslam::CommandLineArgs& args) {
       "%.3f\n",
       ate.num_est, ate.num_gt, ate.pairs.size(), static_cast<long long>(options.max_time_diff_us),
       tracked);
-  std::printf("  alignment %s: scale %.6f\n", options.alignment.c_str(), ate.gt_from_est.scale);
+  std::printf("  alignment %s: scale %.6f\n", alignment_label.c_str(), ate.gt_from_est.scale);
   std::printf("  ATE translation: rmse %.6f m, mean %.6f, median %.6f, max %.6f\n",
               ate.translation.rmse, ate.translation.mean, ate.translation.median,
               ate.translation.max);
@@ -184,7 +211,7 @@ int RunAte(const mbslam::CommandLineArgs& args) {
     char title[256];
     std::snprintf(title, sizeof(title), "%s  ATE %.4f m (%s)",
                   args.Get("title", fs::path(est_description).filename().string()).c_str(),
-                  ate.translation.rmse, options.alignment.c_str());
+                  ate.translation.rmse, alignment_label.c_str());
     plot.title = title;
     st = eval::WriteTopView(args.Get("plot"), gt, ate.est_aligned, plot);
     if (!st.ok()) {
@@ -193,7 +220,9 @@ int RunAte(const mbslam::CommandLineArgs& args) {
     std::printf("  plot: %s\n", args.Get("plot").c_str());
   }
   Json j = Json::Object();
-  j.Set("metric", "ate").Set("alignment", options.alignment).Set("orientation_aligned", ate.orientation_aligned);
+  j.Set("metric", "ate")
+      .Set("alignment", alignment_label)
+      .Set("orientation_aligned", ate.orientation_aligned);
   j.Set("ate_rmse_m", ate.translation.rmse).Set("ate_mean_m", ate.translation.mean);
   j.Set("ate_median_m", ate.translation.median).Set("ate_max_m", ate.translation.max);
   j.Set("ate_rot_rmse_deg", ate.rotation_deg.rmse).Set("scale", ate.gt_from_est.scale);
@@ -888,6 +917,8 @@ void Usage() {
            --est F.tum | --est-log LOG [--est-channel C]
            --gt F.tum | --gt-log LOG [--gt-channel C] | --gt-sequence DIR | --gt-tartanair pose_left.txt
            [--align sim3|se3|none] [--max-dt-us N] [--rpe-delta N | --rpe-delta-us N] [--plot OUT.png] [--title T]
+           [--align-est OTHER.tum (--align-gt-log LOG | --align-gt F.tum)]: the alignment of another run
+           (in the same map) against its truth, applied as it is
   seg      track misclassification (Hungarian matching)
            --pred LABELS --truth LABELS|X.tracks.txt
            --pred-dir DIR [--tracks-dir DIR (default: Hopkins 155)] [--pred-suffix .labels.txt] [--include-dancing]

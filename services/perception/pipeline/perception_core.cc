@@ -47,6 +47,20 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
   base_from_cam_ = Rigid3d(Eigen::Quaterniond(q[0], q[1], q[2], q[3]), Eigen::Vector3d(t[0], t[1], t[2]));
 }
 
+int64_t PerceptionCore::UnmappedTrackAt(const Eigen::Vector2f& uv, float radius_px) const {
+  int64_t best = -1;
+  float best_d2 = radius_px * radius_px;
+  for (const Track& t : tracker_.tracks()) {
+    if (!t.active() || t.body_id > 0 || slam_.HasPoint(t.id)) continue;
+    const float d2 = (t.uv - uv).squaredNorm();
+    if (d2 <= best_d2) {
+      best_d2 = d2;
+      best = t.id;
+    }
+  }
+  return best;
+}
+
 std::vector<std::pair<int64_t, Rigid3d>> PerceptionCore::AdjustedCameraTrajectory() const {
   std::vector<std::pair<int64_t, Rigid3d>> out = slam_.AdjustedTrajectory();
   for (auto& [utime, pose] : out) pose = pose.Inverse();  // world_from_cam
@@ -562,10 +576,20 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     ScopedStageTimer timer(slam_timer_);
     slam_pose = slam_.TrackPose(slam_frame);
     if (slam_pose.epipolar_assisted) counters_->Increment(counter::kPoseEpipolarAssisted);
+    if (slam_pose.relocalized && slam_pose.valid) counters_->Increment(counter::kPoseRelocalized);
     // Re-found map points become tracks again (they rejoin the segmentation as static).
     for (const auto& [point_id, uv] : slam_pose.refound) {
       const int64_t track_id = tracker_.AdoptTrack(uv, 0);
-      if (track_id < 0) continue;
+      if (track_id < 0) {
+        // In a map that relocalised, re-found points are often corners the tracker's own
+        // detector found too: the track already there, if it holds no point and is not
+        // held moving, takes the point.
+        if (slam_pose.relocalized_map) {
+          const int64_t here = UnmappedTrackAt(uv, kRelocalizedTrackRadiusPx);
+          if (here >= 0) slam_.AssociateTrack(point_id, here);
+        }
+        continue;
+      }
       slam_.AssociateTrack(point_id, track_id);
       SlamObservation o;
       o.track_id = track_id;

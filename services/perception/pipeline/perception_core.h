@@ -134,6 +134,11 @@ class PerceptionCore : public FrameProcessor {
   std::vector<std::pair<int64_t, Rigid3d>> AdjustedCameraTrajectory() const override;
 
  private:
+  // A relocalised image's match lands this close to a track the tracker already has (px).
+  static constexpr float kRelocalizedTrackRadiusPx = 2.0f;
+  // The active track nearest to uv within radius_px that holds no map point and is not
+  // labelled moving, or -1.
+  int64_t UnmappedTrackAt(const Eigen::Vector2f& uv, float radius_px) const;
   std::optional<RelativeMotion> OdometryMotion(int64_t ref_frame, int64_t cur_frame) const;
   std::optional<Rigid3d> OdometryCameraPose(int64_t utime) const;
   void FillCameraPose(const SlamPose& pose, CameraPoseOutput* out) const;

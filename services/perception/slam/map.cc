@@ -1,9 +1,11 @@
 #include "services/perception/slam/map.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#include <string>
 
 #include "common/util/atomic_file.h"
 
@@ -112,10 +114,42 @@ void Map::Rescale(double s) {
   for (auto& [id, p] : points_) p.position *= s;
 }
 
+namespace {
+
+std::string HexOf(const uint8_t* bytes, size_t n) {
+  static const char* kDigits = "0123456789abcdef";
+  std::string hex(2 * n, '0');
+  for (size_t i = 0; i < n; ++i) {
+    hex[2 * i] = kDigits[bytes[i] >> 4];
+    hex[2 * i + 1] = kDigits[bytes[i] & 15];
+  }
+  return hex;
+}
+
+bool BytesOfHex(const std::string& hex, uint8_t* bytes, size_t n) {
+  if (hex.size() != 2 * n) return false;
+  auto nibble = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  for (size_t i = 0; i < n; ++i) {
+    const int hi = nibble(hex[2 * i]), lo = nibble(hex[2 * i + 1]);
+    if (hi < 0 || lo < 0) return false;
+    bytes[i] = static_cast<uint8_t>(hi * 16 + lo);
+  }
+  return true;
+}
+
+constexpr int kMaxPatchSide = 63;  // larger patches in a file are refused (px)
+
+}  // namespace
+
 Status Map::Save(const std::string& path) const {
   return WriteFileAtomically(path, [this](std::ostream& out) {
     out << std::setprecision(17);
-    out << "mbslam_map 1\n";
+    out << "mbslam_map 2\n";
     out << "keyframes " << keyframes_.size() << "\n";
     for (const auto& [id, k] : keyframes_) {
       const Rigid3d& T = k.cam_from_world;
@@ -133,6 +167,17 @@ Status Map::Save(const std::string& path) const {
       out << id << " " << p.position.x() << " " << p.position.y() << " " << p.position.z() << " "
           << static_cast<int>(p.gray) << " " << p.observations.size();
       for (const Observation& o : p.observations) out << " " << o.keyframe_id << " " << o.xy.x() << " " << o.xy.y();
+      out << " "
+          << (p.has_descriptor ? HexOf(p.descriptor.bits.data(), p.descriptor.bits.size())
+                               : std::string("-"));
+      const bool patch = !p.patch.empty() && p.patch.type() == CV_8UC1 &&
+                         p.patch.rows == p.patch.cols && p.patch.rows <= kMaxPatchSide &&
+                         p.patch.isContinuous();
+      if (patch) {
+        out << " " << p.patch.rows << " " << HexOf(p.patch.ptr<uint8_t>(0), p.patch.total());
+      } else {
+        out << " 0";
+      }
       out << "\n";
     }
     return static_cast<bool>(out);
@@ -145,7 +190,8 @@ Status Map::Load(const std::string& path) {
   std::string magic;
   int version = 0;
   in >> magic >> version;
-  if (magic != "mbslam_map" || version != 1) return Status::Error(path + ": not an mbslam map");
+  if (magic != "mbslam_map" || (version != 1 && version != 2))
+    return Status::Error(path + ": not an mbslam map");
   Map loaded;
   std::string word;
   size_t n = 0;
@@ -158,7 +204,14 @@ Status Map::Load(const std::string& path) {
     if (!(in >> k.id >> k.frame_index >> k.utime >> qw >> qx >> qy >> qz >> tx >> ty >> tz >> fixed)) {
       return Status::Error(path + ": truncated keyframe");
     }
-    k.cam_from_world = Rigid3d(Eigen::Quaterniond(qw, qx, qy, qz), Eigen::Vector3d(tx, ty, tz));
+    const Eigen::Quaterniond q(qw, qx, qy, qz);
+    const Eigen::Vector3d t(tx, ty, tz);
+    if (!q.coeffs().allFinite() || !t.allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
+      return Status::Error(path + ": keyframe " + std::to_string(k.id) + " has a bad pose");
+    }
+    if (loaded.keyframes_.count(k.id))
+      return Status::Error(path + ": keyframe " + std::to_string(k.id) + " twice");
+    k.cam_from_world = Rigid3d(q.normalized(), t);
     k.fixed = fixed != 0;
     loaded.next_keyframe_id_ = std::max(loaded.next_keyframe_id_, k.id + 1);
     loaded.keyframes_[k.id] = std::move(k);
@@ -172,12 +225,42 @@ Status Map::Load(const std::string& path) {
     if (!(in >> p.id >> p.position.x() >> p.position.y() >> p.position.z() >> gray >> nobs) || nobs > 100000) {
       return Status::Error(path + ": truncated point");
     }
+    if (!p.position.allFinite() || gray < 0 || gray > 255) {
+      return Status::Error(path + ": point " + std::to_string(p.id) +
+                           " is not finite or has a bad grey level");
+    }
+    if (loaded.points_.count(p.id))
+      return Status::Error(path + ": point " + std::to_string(p.id) + " twice");
     p.gray = static_cast<uint8_t>(gray);
     for (size_t j = 0; j < nobs; ++j) {
       Observation o;
       if (!(in >> o.keyframe_id >> o.xy.x() >> o.xy.y())) return Status::Error(path + ": truncated observation");
+      Keyframe* k = loaded.keyframe(o.keyframe_id);
+      if (!k || !o.xy.allFinite()) {
+        return Status::Error(path + ": point " + std::to_string(p.id) + " has a bad observation");
+      }
       p.observations.push_back(o);
-      if (Keyframe* k = loaded.keyframe(o.keyframe_id)) k->point_ids.push_back(p.id);
+      k->point_ids.push_back(p.id);
+    }
+    if (version >= 2) {
+      std::string hex;
+      if (!(in >> hex)) return Status::Error(path + ": truncated point descriptor");
+      if (hex != "-") {
+        if (!BytesOfHex(hex, p.descriptor.bits.data(), p.descriptor.bits.size())) {
+          return Status::Error(path + ": point " + std::to_string(p.id) + " has a bad descriptor");
+        }
+        p.has_descriptor = true;
+      }
+      int side = 0;
+      if (!(in >> side) || side < 0 || side > kMaxPatchSide) {
+        return Status::Error(path + ": point " + std::to_string(p.id) + " has a bad patch size");
+      }
+      if (side > 0) {
+        p.patch.create(side, side, CV_8UC1);
+        if (!(in >> hex) || !BytesOfHex(hex, p.patch.ptr<uint8_t>(0), p.patch.total())) {
+          return Status::Error(path + ": point " + std::to_string(p.id) + " has a bad patch");
+        }
+      }
     }
     loaded.next_point_id_ = std::max(loaded.next_point_id_, p.id + 1);
     loaded.points_[p.id] = std::move(p);

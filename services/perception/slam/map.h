@@ -17,6 +17,7 @@
 
 #include "common/util/status.h"
 #include "services/perception/geometry/rigid3.h"
+#include "services/perception/tracking/orb_features.h"
 
 namespace mbslam {
 
@@ -49,6 +50,9 @@ struct MapPoint {
   int64_t released_frame = -1;      // image at which its last track was released (moving, or drifted off it); -1 = never
   uint8_t gray = 128;               // intensity at creation (for display)
   cv::Mat patch;                    // appearance at the last observation (guided matching)
+  // ORB descriptor at its latest keyframe observation (relocalisation), when it has one.
+  bool has_descriptor = false;
+  OrbDescriptor descriptor;
 };
 
 struct Keyframe {
@@ -100,7 +104,11 @@ class Map {
   // Multiplies every position by s (gauge change, e.g. to metric units).
   void Rescale(double s);
 
-  // Text file: keyframes (id, frame, utime, pose) and points (id, xyz, observations).
+  // Text file: keyframes (id, frame, utime, pose) and points (id, xyz, grey level,
+  // observations, ORB descriptor as 64 hex digits or "-", guided matching patch as its
+  // side and hex bytes or 0). Load reads this (version 2)
+  // and version 1 (without descriptors); it refuses malformed or non-finite numbers and
+  // observations of missing keyframes, and leaves the map as it was then.
   Status Save(const std::string& path) const;
   Status Load(const std::string& path);
 

@@ -3,6 +3,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
 #include "common/testing/temp_dir.h"
 
 namespace mbslam {
@@ -73,6 +79,80 @@ TEST(Map, RemoveStalePointsDropsUnderObservedPointsNoTrackMatches) {
   EXPECT_EQ(map.RemoveStalePoints(/*seen_before_frame=*/101), 2);
   EXPECT_EQ(map.num_points(), 1u);
   EXPECT_EQ(map.RemoveStalePoints(1000), 0);
+}
+
+// Relocalisation needs a point's ORB descriptor and guided matching its patch after a
+// reload; version 1 files (without them) still load; a damaged file is refused whole.
+TEST(Map, SaveLoadKeepsDescriptorsAndPatchesAndRefusesDamage) {
+  Map map;
+  Keyframe k;
+  k.cam_from_world = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY())),
+                             Eigen::Vector3d(0, 1, 0));
+  const int64_t kid = map.AddKeyframe(k);
+  MapPoint described;
+  described.position = Eigen::Vector3d(1, 2, 3);
+  described.has_descriptor = true;
+  for (size_t i = 0; i < described.descriptor.bits.size(); ++i)
+    described.descriptor.bits[i] = static_cast<uint8_t>(7 * i + 3);
+  described.patch = cv::Mat(11, 11, CV_8UC1);
+  for (int i = 0; i < 121; ++i)
+    described.patch.at<uint8_t>(i / 11, i % 11) = static_cast<uint8_t>(2 * i);
+  const int64_t a = map.AddPoint(described);
+  MapPoint plain;
+  plain.position = Eigen::Vector3d(-1, 0, 5);
+  const int64_t b = map.AddPoint(plain);
+  map.AddObservation(a, kid, Eigen::Vector2d(0.1, 0.2));
+  map.AddObservation(b, kid, Eigen::Vector2d(-0.3, 0.0));
+  const std::string dir = testing_util::MakeTestTempDir("map_descriptors");
+  ASSERT_TRUE(map.Save(dir + "/map.txt").ok());
+  Map loaded;
+  ASSERT_TRUE(loaded.Load(dir + "/map.txt").ok());
+  ASSERT_TRUE(loaded.point(a)->has_descriptor);
+  EXPECT_EQ(loaded.point(a)->descriptor.bits, described.descriptor.bits);
+  ASSERT_EQ(loaded.point(a)->patch.rows, 11);
+  EXPECT_EQ(cv::norm(loaded.point(a)->patch, described.patch, cv::NORM_INF), 0.0);
+  EXPECT_FALSE(loaded.point(b)->has_descriptor);
+  EXPECT_TRUE(loaded.point(b)->patch.empty());
+
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir + "/" + name) << text;
+    return dir + "/" + name;
+  };
+  const std::string keyframe = "keyframes 1\n0 3 1000 1 0 0 0 0 0 0 1\n";
+  // Version 1: no descriptor, no patch.
+  Map v1;
+  ASSERT_TRUE(
+      v1.Load(write("v1.txt", "mbslam_map 1\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2\n"))
+          .ok());
+  EXPECT_EQ(v1.num_points(), 1u);
+  EXPECT_FALSE(v1.point(4)->has_descriptor);
+  const std::string hex(64, 'a');
+  const std::vector<std::string> damaged = {
+      "mbslam_map 3\n" + keyframe + "points 0\n",  // unknown version
+      "mbslam_map 2\n" + keyframe +
+          "points 1\n4 nan 2 3 128 1 0 0.1 0.2 - 0\n",                          // non-finite point
+      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 300 1 0 0.1 0.2 - 0\n",  // grey level
+      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 9 0.1 0.2 - 0\n",  // missing keyframe
+      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2 " + hex.substr(1) +
+          "g 0\n",                                                                 // bad hex
+      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2 - 3 00\n",  // short patch
+      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2 - 99\n",  // patch too large
+      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2\n",       // truncated
+      "mbslam_map 2\nkeyframes 1\n0 3 1000 2 0 0 0 0 0 0 1\npoints 0\n",         // not a rotation
+  };
+  for (size_t i = 0; i < damaged.size(); ++i) {
+    Map m = loaded;
+    EXPECT_FALSE(m.Load(write("bad" + std::to_string(i) + ".txt", damaged[i])).ok()) << damaged[i];
+    EXPECT_EQ(m.num_points(), 2u) << "a refused file leaves the map as it was";
+  }
+  // A well-formed version 2 line with a descriptor and a patch of side 1.
+  Map good;
+  ASSERT_TRUE(
+      good.Load(write("good.txt", "mbslam_map 2\n" + keyframe +
+                                      "points 1\n4 1 2 3 128 1 0 0.1 0.2 " + hex + " 1 7f\n"))
+          .ok());
+  EXPECT_EQ(good.point(4)->descriptor.bits[0], 0xaa);
+  EXPECT_EQ(good.point(4)->patch.at<uint8_t>(0, 0), 0x7f);
 }
 
 }  // namespace

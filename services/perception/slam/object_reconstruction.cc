@@ -277,13 +277,14 @@ SlamOptions ObjectReconstruction::ObjectSlamOptions(const ObjectReconstructionOp
   // its initialisation is acceptable, without waiting for more parallax.
   s.init_good_parallax_deg = 0.0;
   // No odometry (it moves the camera, not the object), no images (guided matching), no
-  // back-filled poses, no map files.
+  // back-filled poses, no map files, no relocalisation.
   s.use_odometry = false;
   s.guided_matching = false;
   s.backfill_max_frames = 0;
   s.use_segmentation = true;
   s.map_load_path.clear();
   s.map_save_path.clear();
+  s.relocalization = false;
   // Its trajectory file is written as tracked (no adjusted trajectory kept).
   s.adjusted_trajectory_max_poses = 0;
   s.rotation_prior_floor_rad = options.rotation_prior_floor_rad;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <sstream>
 #include <unordered_set>
 
 #include <opencv2/calib3d.hpp>
@@ -17,6 +18,7 @@
 #include "services/perception/geometry/polygon.h"
 #include "services/perception/slam/init_selection.h"
 #include "services/perception/slam/triangulation.h"
+#include "services/perception/tracking/orb_features.h"
 #include "services/perception/tracking/patch_matcher.h"
 
 namespace mbslam {
@@ -110,6 +112,8 @@ void SlamSystem::Reset() {
   hybrid_frames_ = 0;
   released_tracks_.clear();
   ground_plane_.reset();
+  awaiting_loaded_map_ = false;
+  relocalized_map_ = false;
 }
 
 std::optional<double> CameraHeightAboveGround(const std::vector<Eigen::Vector3d>& points_in_cam,
@@ -179,9 +183,28 @@ Status SlamSystem::LoadMap(const std::string& path) {
   ResolveTrajectory();  // the loaded map's keyframe and point ids start again
   refine_obs_.clear();
   MBSLAM_RETURN_IF_ERROR(map_.Load(path));
-  // A loaded map is only trusted after the camera relocalises against it; without
-  // descriptors that means re-initialising, so it serves as a prior for display.
-  MBSLAM_LOG(INFO) << "map loaded: " << map_.num_keyframes() << " keyframes, " << map_.num_points() << " points";
+  ++map_generation_;
+  recent_poses_.clear();
+  lost_frames_ = 0;
+  hybrid_frames_ = 0;
+  metric_ = false;
+  ground_plane_.reset();
+  relocalized_map_ = false;
+  size_t described = 0;
+  for (const auto& [id, p] : map_.points()) described += p.has_descriptor ? 1 : 0;
+  // A loaded map is only trusted once the camera relocalises in it: until then the
+  // service is lost in it (relocalisation) for at most reloc_loaded_max_frames images.
+  // Without descriptors (an older file) it cannot relocalise: the first initialisation
+  // replaces it.
+  const bool relocalizable =
+      options_.relocalization && described >= static_cast<size_t>(options_.reloc_min_inliers);
+  state_ = relocalizable ? SlamState::kLost : SlamState::kNotInitialized;
+  awaiting_loaded_map_ = relocalizable;
+  MBSLAM_LOG(INFO) << log_name_ << ": map loaded: " << map_.num_keyframes() << " keyframes, "
+                   << map_.num_points() << " points (" << described << " with descriptors)"
+                   << (relocalizable
+                           ? "; waiting for the camera to relocalise in it"
+                           : "; it cannot be relocalised in, the first initialisation replaces it");
   return Status::Ok();
 }
 
@@ -331,6 +354,12 @@ void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
        ++it, ++kfs) {
     candidates.insert(it->second.point_ids.begin(), it->second.point_ids.end());
   }
+  if (relocalized_map_) {
+    for (int64_t kid : NearestKeyframes(T, options_.guided_keyframes)) {
+      const Keyframe* k = map_.keyframe(kid);
+      candidates.insert(k->point_ids.begin(), k->point_ids.end());
+    }
+  }
   // For the debug log only: the held points whose tracks are no longer active (the
   // tracker does not report a track's end to the map; see below).
   std::unordered_set<int64_t> active;
@@ -386,6 +415,123 @@ void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
                     << " held by tracks (" << ended << " of them ended), " << outside
                     << " outside, " << searched << " searched, " << ambiguous << " ambiguous, "
                     << unlike << " unlike, " << point_ids->size() << " re-found";
+}
+
+bool SlamSystem::Relocalize(const SlamFrame& frame, std::vector<Eigen::Vector3d>* X,
+                            std::vector<Eigen::Vector2d>* xy, std::vector<int64_t>* tracks,
+                            std::vector<cv::Mat>* patches, std::vector<int64_t>* refound_ids,
+                            std::vector<Eigen::Vector2f>* refound_uv, PoseEstimate* est) {
+  if (!frame.intrinsics || frame.image.empty()) return false;
+  // The described points not already among the correspondences (through a track or
+  // guided matching), and not behind a moving object.
+  std::unordered_set<int64_t> taken(refound_ids->begin(), refound_ids->end());
+  for (int64_t t : *tracks) {
+    if (t >= 0) taken.insert(map_.PointOfTrack(t));
+  }
+  std::vector<int64_t> ids;
+  std::vector<OrbDescriptor> descriptors;
+  for (const auto& [pid, p] : map_.points()) {
+    if (!p.has_descriptor || p.occluded || taken.count(pid)) continue;
+    ids.push_back(pid);
+    descriptors.push_back(p.descriptor);
+  }
+  if (static_cast<int>(ids.size() + X->size()) < options_.reloc_min_inliers) return false;
+  std::vector<Eigen::Vector2f> corners;
+  std::vector<OrbDescriptor> corner_descriptors;
+  DetectOrb(frame.image, options_.reloc_features, options_.reloc_fast_threshold, &corners,
+            &corner_descriptors);
+  const std::vector<std::pair<int, int>> matches =
+      MatchOrb(corner_descriptors, descriptors, options_.reloc_max_hamming, options_.reloc_ratio);
+  const size_t first = refound_ids->size();
+  for (const auto& [c, m] : matches) {
+    const Eigen::Vector2f& uv = corners[static_cast<size_t>(c)];
+    const int64_t pid = ids[static_cast<size_t>(m)];
+    X->push_back(map_.point(pid)->position);
+    xy->push_back(frame.intrinsics->PixelToNormalized(uv.cast<double>()));
+    tracks->push_back(-1 - static_cast<int64_t>(refound_ids->size()));
+    patches->emplace_back();
+    refound_ids->push_back(pid);
+    refound_uv->push_back(uv);
+  }
+  PoseEstimatorOptions pose = options_.pose;
+  pose.ransac_iterations = options_.reloc_ransac_iterations;
+  *est = PoseEstimate();
+  if (static_cast<int>(X->size()) >= options_.reloc_min_inliers) {
+    *est = EstimatePose(*X, *xy, frame.focal_px, std::nullopt, pose);
+  }
+  const int need = std::max(options_.reloc_min_inliers, options_.min_tracking_inliers);
+  int matched_inliers = 0;
+  for (size_t i = 0; i < tracks->size() && i < est->inliers.size(); ++i) {
+    matched_inliers +=
+        (*tracks)[i] < 0 && static_cast<size_t>(-1 - (*tracks)[i]) >= first && est->inliers[i];
+  }
+  const bool ok = est->ok && est->num_inliers >= need;
+  std::ostringstream what;
+  what << log_name_ << " frame " << frame.frame_index << ": relocalisation "
+       << (ok ? "placed the image" : "failed") << ": " << corners.size() << " corners, "
+       << descriptors.size() << " described points, " << matches.size() << " matches, inliers "
+       << est->num_inliers << " (" << matched_inliers << " of the matches) of " << X->size()
+       << " correspondences";
+  if (ok) {
+    MBSLAM_LOG(INFO) << what.str();
+  } else {
+    MBSLAM_LOG(DEBUG) << what.str();
+  }
+  if (!ok) return false;
+  // Matched points without a guided matching template get one from this image.
+  for (size_t i = 0; i < tracks->size() && i < est->inliers.size(); ++i) {
+    if ((*tracks)[i] >= 0 || !est->inliers[i]) continue;
+    const size_t k = static_cast<size_t>(-1 - (*tracks)[i]);
+    MapPoint* p = map_.point((*refound_ids)[k]);
+    if (p && p->patch.empty())
+      ExtractPatch(frame.image, (*refound_uv)[k], options_.reloc_patch_px, &p->patch);
+  }
+  relocalized_map_ = true;
+  return true;
+}
+
+std::vector<int64_t> SlamSystem::NearestKeyframes(const Rigid3d& cam_from_world, int count) const {
+  // Keyframes looking the same way (optical axes within kMaxAxisAngle), nearest centre first.
+  constexpr double kMaxAxisAngle = 60.0 * kDeg;
+  const Eigen::Vector3d centre = cam_from_world.Inverse().translation;
+  const Eigen::Vector3d axis = cam_from_world.rotation.inverse() * Eigen::Vector3d::UnitZ();
+  std::vector<std::pair<double, int64_t>> ranked;
+  for (const auto& [id, k] : map_.keyframes()) {
+    const Rigid3d world_from_kf = k.cam_from_world.Inverse();
+    const Eigen::Vector3d kf_axis = world_from_kf.rotation * Eigen::Vector3d::UnitZ();
+    if (axis.dot(kf_axis) < std::cos(kMaxAxisAngle)) continue;
+    ranked.emplace_back((world_from_kf.translation - centre).squaredNorm(), id);
+  }
+  const size_t n = std::min(ranked.size(), static_cast<size_t>(std::max(count, 0)));
+  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(n), ranked.end());
+  std::vector<int64_t> ids;
+  for (size_t i = 0; i < n; ++i) ids.push_back(ranked[i].second);
+  return ids;
+}
+
+int SlamSystem::DescribeKeyframePoints(const cv::Mat& image, int64_t keyframe_id) {
+  const Keyframe* k = map_.keyframe(keyframe_id);
+  if (!k || image.empty()) return 0;
+  std::vector<int64_t> ids;
+  std::vector<Eigen::Vector2f> uv;
+  for (const auto& [track, px] : k->track_uv) {
+    const int64_t pid = map_.PointOfTrack(track);
+    if (pid < 0) continue;
+    ids.push_back(pid);
+    uv.push_back(px.cast<float>());
+  }
+  std::vector<OrbDescriptor> descriptors;
+  std::vector<uint8_t> valid;
+  DescribeOrbAt(image, uv, &descriptors, &valid);
+  int described = 0;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    if (!valid[i]) continue;
+    MapPoint* p = map_.point(ids[i]);
+    p->descriptor = descriptors[i];
+    p->has_descriptor = true;
+    ++described;
+  }
+  return described;
 }
 
 std::optional<Rigid3d> SlamSystem::PredictPose(const SlamFrame& frame) const {
@@ -497,6 +643,12 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     good = assisted;
   }
   hybrid_frames_ = assisted ? hybrid_frames_ + 1 : 0;
+  bool relocalized = false;
+  if (!good && options_.relocalization &&
+      (state_ == SlamState::kTracking || state_ == SlamState::kLost)) {
+    relocalized = Relocalize(frame, &X, &xy, &tracks, &patches, &refound_ids, &refound_uv, &est);
+    good = relocalized;
+  }
   if (good && state_ == SlamState::kConfirming) {
     const double ratio = static_cast<double>(est.num_inliers) / static_cast<double>(X.size());
     if (ratio < options_.init_confirm_inlier_ratio) {
@@ -519,6 +671,11 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     const bool recovered = state_ == SlamState::kLost;
     if (recovered) state_ = SlamState::kTracking;
     lost_frames_ = 0;
+    if (relocalized) {
+      out.relocalized = true;
+      awaiting_loaded_map_ = false;
+      ++relocalizations_;
+    }
     out.valid = state_ == SlamState::kTracking;
     out.cam_from_world = est.cam_from_world;
     out.covariance = est.covariance;
@@ -581,9 +738,15 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
       RestartMap(bridge_);
     } else {
       state_ = SlamState::kLost;
-      if (lost_frames_ >= options_.lost_frames_to_reinit) {
-        MBSLAM_LOG(WARNING) << log_name_ << ": lost for " << lost_frames_
-                            << " frames; re-initialising";
+      // A loaded map waits longer for the camera to come back into it.
+      const int give_up =
+          awaiting_loaded_map_ ? options_.reloc_loaded_max_frames : options_.lost_frames_to_reinit;
+      if (give_up > 0 && lost_frames_ >= give_up) {
+        MBSLAM_LOG(WARNING) << log_name_ << ": lost for " << lost_frames_ << " frames"
+                            << (awaiting_loaded_map_ ? " without relocalising in the loaded map"
+                                                     : "")
+                            << "; re-initialising";
+        awaiting_loaded_map_ = false;
         // A bundle adjustment still running is waited for by the restart anyway: its
         // result is merged first, for the pose and the depths the bridge carries over.
         MergeBundleAdjustment(/*wait=*/true);
@@ -618,6 +781,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   out.state = state_;
   out.metric = metric_;
   out.scale_to_metric = metric_ ? 1.0 : 0.0;
+  out.relocalized_map = relocalized_map_;
   last_frame_ = frame.frame_index;
   if (!out.valid) RememberUnposed(frame);
   return out;
@@ -1490,6 +1654,7 @@ void SlamSystem::AddKeyframe(const SlamFrame& frame, const std::unordered_map<in
                     << " unseen by the last keyframes, " << degenerate << " degenerate, "
                     << low_parallax << " low parallax, " << reprojection << " reprojection, "
                     << released << " released before";
+  if (options_.relocalization) DescribeKeyframePoints(frame.image, kid);
   last_keyframe_frame_ = frame.frame_index;
   update->new_keyframe = true;
   update->culled_points = CullKeyframes(frame.frame_index);

@@ -248,6 +248,29 @@ struct SlamOptions {
   bool adjusted_trajectory_skip_released = true;
   std::string map_load_path;             // map loaded at start ("" = none)
   std::string map_save_path;             // map saved at exit ("" = none)
+  // Relocalisation (issue 6: "relocalise against the existing map when the camera
+  // returns"). Each keyframe describes the points its tracks observe (ORB at the track's
+  // position, oriented, full resolution; the point keeps its latest keyframe's
+  // descriptor). An image that the map's tracks and the epipolar-assisted pose cannot
+  // place, while a map exists (lost, or a map loaded from map_load_path), is matched
+  // against every described point (ORB corners of the image, Lowe's ratio test, one to
+  // one) and resected by EPnP RANSAC on the matches with the map's other
+  // correspondences; at least reloc_min_inliers inliers place it. The matched points
+  // then become tracks again. A loaded map waits reloc_loaded_max_frames images for
+  // the camera to relocalise (0 = for ever) before a new map is made; a map lost while
+  // running waits lost_frames_to_reinit as before.
+  bool relocalization = true;
+  int reloc_features = 1000;           // ORB corners detected in the image (count)
+  int reloc_fast_threshold = 10;       // their FAST threshold (grey levels)
+  int reloc_max_hamming = 50;          // descriptor match acceptance (bits of 256)
+  double reloc_ratio = 0.8;            // Lowe ratio test
+  int reloc_min_inliers = 20;          // inliers that place an image (count)
+  int reloc_ransac_iterations = 1000;  // EPnP RANSAC iterations at most (count)
+  // Guided matching template given to matched points without one (px, odd; as
+  // tracking.patch_size).
+  int reloc_patch_px = 11;
+  // Images a loaded map waits for the camera to relocalise (count; 0 = for ever).
+  int reloc_loaded_max_frames = 300;
   // Images that carry a rotation prior (SlamFrame::rotation_prior) constrain the rotation
   // between keyframes (bundle adjustment) and from the last keyframe (tracking) within
   // sigma = floor + rate * elapsed time: the body's angular speed in the reference frame.
@@ -307,6 +330,14 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION(hybrid_ground_step_max_support >= 0.0 &&
                         hybrid_ground_step_max_support <= 1.0);
     MBSLAM_CHECK_OPTION_GE(lost_frames_to_reinit, 1);
+    MBSLAM_CHECK_OPTION_GT(reloc_features, 0);
+    MBSLAM_CHECK_OPTION(reloc_fast_threshold >= 1 && reloc_fast_threshold <= 255);
+    MBSLAM_CHECK_OPTION(reloc_max_hamming > 0 && reloc_max_hamming <= 256);
+    MBSLAM_CHECK_OPTION(reloc_ratio > 0.0 && reloc_ratio <= 1.0);
+    MBSLAM_CHECK_OPTION_GE(reloc_min_inliers, 6);
+    MBSLAM_CHECK_OPTION_GT(reloc_ransac_iterations, 0);
+    MBSLAM_CHECK_OPTION(reloc_patch_px >= 5 && reloc_patch_px % 2 == 1);
+    MBSLAM_CHECK_OPTION_GE(reloc_loaded_max_frames, 0);
     MBSLAM_CHECK_OPTION(bridge_units == "speed" || bridge_units == "depth");
     MBSLAM_CHECK_OPTION_GE(bridge_ground_min_points, 3);
     MBSLAM_CHECK_OPTION(bridge_ground_min_share >= 0.0 && bridge_ground_min_share <= 1.0);
@@ -435,6 +466,23 @@ struct SlamOptions {
       "afterwards (no longer static, or drifted off it)");
     v("map_load_path", &map_load_path, "map loaded at start (\"\" = none)");
     v("map_save_path", &map_save_path, "map saved at exit (\"\" = none)");
+    v("relocalization", &relocalization,
+      "an image the map's tracks cannot place is matched against the map points' ORB "
+      "descriptors (kept at keyframes) and resected on them; also how a loaded map is found again");
+    v("reloc_features", &reloc_features, "ORB corners detected in an image to relocalise (count)");
+    v("reloc_fast_threshold", &reloc_fast_threshold, "their FAST threshold (grey levels)");
+    v("reloc_max_hamming", &reloc_max_hamming, "descriptor match acceptance (bits of 256)");
+    v("reloc_ratio", &reloc_ratio, "Lowe ratio test of the relocalisation's matches");
+    v("reloc_min_inliers", &reloc_min_inliers,
+      "EPnP RANSAC inliers that place a relocalised image (count)");
+    v("reloc_ransac_iterations", &reloc_ransac_iterations,
+      "EPnP RANSAC iterations at most (count)");
+    v("reloc_patch_px", &reloc_patch_px,
+      "guided matching template given to relocalised points without one, odd (px; as "
+      "tracking.patch_size)");
+    v("reloc_loaded_max_frames", &reloc_loaded_max_frames,
+      "images a loaded map waits for the camera to relocalise before a new map is made (count; 0 = "
+      "for ever)");
   }
 };
 
@@ -466,7 +514,11 @@ enum class SlamState { kNotInitialized, kInitializing, kConfirming, kTracking, k
 struct SlamPose {
   SlamState state = SlamState::kNotInitialized;
   bool valid = false;                      // a pose for this image exists
-  bool relocalized = false;                // first pose after a re-initialisation
+  bool relocalized = false;  // first pose after a re-initialisation, or placed by relocalisation
+  // The map has placed an image by relocalisation (SlamOptions::relocalization): its
+  // re-found points may take the tracks already at their positions (the tracker's own
+  // detections of the same corners), which ties new keyframes to the old points.
+  bool relocalized_map = false;
   Rigid3d cam_from_world;
   Matrix6d covariance = Matrix6d::Zero();  // left perturbation [t; r] of cam_from_world
   int num_inliers = 0;
@@ -584,6 +636,8 @@ class SlamSystem {
   };
   const RefineStats& refine_stats() const { return refine_stats_; }
   double last_ba_seconds() const { return last_ba_seconds_; }
+  // Images placed by relocalisation (SlamOptions::relocalization) so far.
+  int64_t relocalizations() const { return relocalizations_; }
 
   Status SaveMap(const std::string& path);
   Status LoadMap(const std::string& path);
@@ -663,6 +717,20 @@ class SlamSystem {
   void FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& cam_from_world,
                            std::vector<int64_t>* point_ids, std::vector<Eigen::Vector2d>* xy,
                            std::vector<Eigen::Vector2f>* uv);
+  // Relocalisation (SlamOptions::relocalization): ORB corners of the image matched to the
+  // described map points not already among the correspondences are appended to them
+  // (as re-found points: `tracks` -1 - k for refound_ids[k]), and the image is resected
+  // on all of them by EPnP RANSAC. True when at least reloc_min_inliers are inliers.
+  bool Relocalize(const SlamFrame& frame, std::vector<Eigen::Vector3d>* X,
+                  std::vector<Eigen::Vector2d>* xy, std::vector<int64_t>* tracks,
+                  std::vector<cv::Mat>* patches, std::vector<int64_t>* refound_ids,
+                  std::vector<Eigen::Vector2f>* refound_uv, PoseEstimate* est);
+  // The `count` keyframes whose cameras are nearest the camera of `cam_from_world` among
+  // those looking the same way (optical axes within 60 deg).
+  std::vector<int64_t> NearestKeyframes(const Rigid3d& cam_from_world, int count) const;
+  // Gives the points observed by keyframe `keyframe_id` through its tracks the ORB
+  // descriptor of `image` (the keyframe's) at their tracks. Returns how many.
+  int DescribeKeyframePoints(const cv::Mat& image, int64_t keyframe_id);
 
   const SlamOptions options_;
   const std::string log_name_;
@@ -759,6 +827,14 @@ class SlamSystem {
   int last_inliers_ = 0;
   bool metric_ = false;
   bool just_initialized_ = false;
+  // A map loaded from a file waits for the camera to relocalise in it (reloc_loaded_max_frames).
+  bool awaiting_loaded_map_ = false;
+  // This map placed an image by relocalisation: from then on guided matching also
+  // searches the points of the keyframes nearest the predicted pose (the recent ones may
+  // be far from where the camera came back to: a loaded map's last keyframes are where
+  // its run ended). Maps that never relocalised search the recent keyframes only.
+  bool relocalized_map_ = false;
+  int64_t relocalizations_ = 0;
   int64_t map_generation_ = 0;
   bool rotation_prior_active_ = false;  // this map was initialised with the rotation prior and keeps it
 

@@ -18,6 +18,7 @@
 #include "services/perception/geometry/polygon.h"
 #include "services/perception/tracking/disc_stamp.h"
 #include "services/perception/tracking/klt.h"
+#include "services/perception/tracking/orb_features.h"
 #include "services/perception/tracking/patch_matcher.h"
 
 namespace mbslam {
@@ -38,42 +39,6 @@ namespace {
 bool InBorder(const Eigen::Vector2f& uv, const cv::Mat& image, float border) {
   return uv.x() >= border && uv.y() >= border && uv.x() <= image.cols - 1 - border &&
          uv.y() <= image.rows - 1 - border;
-}
-
-// Hamming distance of two binary descriptors of `bytes` bytes (as cv::NORM_HAMMING, without
-// a Mat header per pair: the fallback compares hundreds of thousands of pairs).
-int HammingDistance(const uint8_t* a, const uint8_t* b, int bytes) {
-  int d = 0;
-  int k = 0;
-  for (; k + 8 <= bytes; k += 8) {
-    uint64_t x, y;
-    std::memcpy(&x, a + k, 8);
-    std::memcpy(&y, b + k, 8);
-    d += __builtin_popcountll(x ^ y);
-  }
-  for (; k < bytes; ++k) d += __builtin_popcount(static_cast<unsigned>(a[k] ^ b[k]));
-  return d;
-}
-
-// ORB's orientation of a point (the intensity centroid of the disc of radius 15 around
-// it, degrees in [0, 360)), for descriptors computed at given positions: cv::ORB::compute
-// takes a provided keypoint's angle as it is, and the keypoints it detects in the other
-// image are oriented. -1 when the disc leaves the image.
-float IntensityCentroidAngle(const cv::Mat& image, const cv::Point2f& pt) {
-  constexpr int kRadius = 15;
-  const int cx = static_cast<int>(std::lround(pt.x)), cy = static_cast<int>(std::lround(pt.y));
-  if (cx < kRadius || cy < kRadius || cx >= image.cols - kRadius || cy >= image.rows - kRadius) return -1.0f;
-  int64_t m01 = 0, m10 = 0;
-  for (int v = -kRadius; v <= kRadius; ++v) {
-    const int u_max = static_cast<int>(std::floor(std::sqrt(kRadius * kRadius - v * v + 0.5)));
-    const uint8_t* row = image.ptr<uint8_t>(cy + v);
-    for (int u = -u_max; u <= u_max; ++u) {
-      const int i = row[cx + u];
-      m10 += u * i;
-      m01 += v * i;
-    }
-  }
-  return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
 }
 
 // The brightness change of one image to the next, as the map that undoes it:

@@ -1,0 +1,186 @@
+// Relocalisation against a map loaded from a file (SlamOptions::relocalization): a
+// textured, tilted plane seen from a first camera makes the map (ORB descriptors and
+// patches at its corners, as keyframes describe their points); a second camera, turned
+// and moved, is placed in it from its image alone. An unrelated image is not placed, and
+// a loaded map the camera never comes back to is given up after reloc_loaded_max_frames.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "common/testing/temp_dir.h"
+#include "services/perception/geometry/camera.h"
+#include "services/perception/slam/slam_system.h"
+#include "services/perception/tracking/orb_features.h"
+#include "services/perception/tracking/patch_matcher.h"
+#include "services/perception/tracking/test_images.h"
+
+namespace mbslam {
+namespace {
+
+constexpr int kWidth = 640, kHeight = 480;
+constexpr double kTexel = 0.005;  // plane texture resolution (m per texel)
+
+CameraIntrinsics Intrinsics() {
+  CameraIntrinsics K;
+  K.width = kWidth;
+  K.height = kHeight;
+  K.fx = K.fy = 500.0;
+  K.cx = 320.0;
+  K.cy = 240.0;
+  return K;
+}
+
+// The plane: origin O, texel axes e1, e2 (world), tilted 17 deg about x, 4 m ahead.
+struct Plane {
+  Eigen::Vector3d origin{-2.5, -2.0, 3.4};
+  Eigen::Vector3d e1 = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d e2 = Eigen::Vector3d(0.0, 1.0, 0.3).normalized();
+  Eigen::Vector3d Normal() const { return e1.cross(e2).normalized(); }
+};
+
+cv::Mat Render(const cv::Mat& texture, const Plane& plane, const Rigid3d& cam_from_world) {
+  const Eigen::Matrix3d R = cam_from_world.rotation.toRotationMatrix();
+  Eigen::Matrix3d M;
+  M.col(0) = R * plane.e1 * kTexel;
+  M.col(1) = R * plane.e2 * kTexel;
+  M.col(2) = R * plane.origin + cam_from_world.translation;
+  const Eigen::Matrix3d H = Intrinsics().K() * M;
+  cv::Mat Hcv(3, 3, CV_64F);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) Hcv.at<double>(r, c) = H(r, c);
+  }
+  cv::Mat image;
+  cv::warpPerspective(texture, image, Hcv, cv::Size(kWidth, kHeight), cv::INTER_LINEAR,
+                      cv::BORDER_CONSTANT, cv::Scalar(128));
+  return image;
+}
+
+// The map of camera A's view: its ORB corners back-projected onto the plane, described
+// and given patches as the SLAM does at keyframes. Returns the file.
+std::string MakeMap(const cv::Mat& image, const Plane& plane, const std::string& dir) {
+  const CameraIntrinsics K = Intrinsics();
+  std::vector<Eigen::Vector2f> corners;
+  std::vector<OrbDescriptor> unused;
+  DetectOrb(image, 800, 10, &corners, &unused);
+  std::vector<OrbDescriptor> descriptors;
+  std::vector<uint8_t> valid;
+  DescribeOrbAt(image, corners, &descriptors, &valid);
+  Map map;
+  Keyframe k;
+  k.fixed = true;
+  const int64_t kid = map.AddKeyframe(k);  // camera A at the world origin
+  const Eigen::Vector3d n = plane.Normal();
+  for (size_t i = 0; i < corners.size(); ++i) {
+    if (!valid[i]) continue;
+    const Eigen::Vector2d xy = K.PixelToNormalized(corners[i].cast<double>());
+    const Eigen::Vector3d ray = xy.homogeneous();
+    MapPoint p;
+    p.position = ray * (n.dot(plane.origin) / n.dot(ray));
+    p.has_descriptor = true;
+    p.descriptor = descriptors[i];
+    ExtractPatch(image, corners[i], 11, &p.patch);
+    const int64_t pid = map.AddPoint(p);
+    map.AddObservation(pid, kid, xy);
+  }
+  const std::string path = dir + "/plane.map";
+  EXPECT_TRUE(map.Save(path).ok());
+  return path;
+}
+
+SlamFrame FrameOf(int64_t index, const cv::Mat& image, const CameraIntrinsics& K) {
+  SlamFrame f;
+  f.frame_index = index;
+  f.utime = index * 33333;
+  f.focal_px = K.fx;
+  f.image = image;
+  f.intrinsics = &K;
+  return f;
+}
+
+TEST(SlamRelocalization, LoadedMapPlacesATurnedAndMovedCamera) {
+  const cv::Mat texture = testing_images::Texture(1000, 800, 21);
+  const Plane plane;
+  const std::string path =
+      MakeMap(Render(texture, plane, Rigid3d()), plane, testing_util::MakeTestTempDir("reloc"));
+  SlamOptions options;
+  options.map_load_path = path;
+  SlamSystem slam(options);
+  ASSERT_EQ(slam.state(), SlamState::kLost)
+      << "a loaded map waits for the camera to relocalise in it";
+  ASSERT_GT(slam.map().num_points(), 150u);
+  const CameraIntrinsics K = Intrinsics();
+  // Camera B: turned 8 deg about y and 4 deg about x, moved 0.4 m right, 0.1 m up, 0.3 m ahead.
+  const Eigen::Quaterniond q =
+      Eigen::Quaterniond(Eigen::AngleAxisd(8.0 * M_PI / 180.0, Eigen::Vector3d::UnitY())) *
+      Eigen::AngleAxisd(4.0 * M_PI / 180.0, Eigen::Vector3d::UnitX());
+  const Eigen::Vector3d centre(0.4, -0.1, 0.3);
+  const Rigid3d cam_from_world(q.conjugate(), -(q.conjugate() * centre));
+  const SlamPose pose = slam.TrackPose(FrameOf(0, Render(texture, plane, cam_from_world), K));
+  ASSERT_TRUE(pose.valid);
+  EXPECT_TRUE(pose.relocalized);
+  EXPECT_TRUE(pose.relocalized_map);
+  EXPECT_EQ(slam.state(), SlamState::kTracking);
+  EXPECT_LT(TranslationDistance(pose.cam_from_world, cam_from_world), 0.02);
+  EXPECT_LT(RotationDistance(pose.cam_from_world, cam_from_world) * 180.0 / M_PI, 0.3);
+  EXPECT_GE(pose.num_inliers, options.reloc_min_inliers);
+  EXPECT_GE(pose.refound.size(), static_cast<size_t>(options.reloc_min_inliers))
+      << "matched points become tracks";
+  EXPECT_EQ(slam.relocalizations(), 1);
+  // The matched points lie where the true pose projects them.
+  for (const auto& [pid, uv] : pose.refound) {
+    const Eigen::Vector2d expected = K.Project(cam_from_world * slam.map().point(pid)->position);
+    EXPECT_LT((uv.cast<double>() - expected).norm(), 3.0);
+  }
+}
+
+TEST(SlamRelocalization, UnrelatedImagesAreNotPlacedAndTheLoadedMapIsGivenUp) {
+  const cv::Mat texture = testing_images::Texture(1000, 800, 21);
+  const Plane plane;
+  const std::string path = MakeMap(Render(texture, plane, Rigid3d()), plane,
+                                   testing_util::MakeTestTempDir("reloc_unrelated"));
+  SlamOptions options;
+  options.map_load_path = path;
+  options.reloc_loaded_max_frames = 4;
+  SlamSystem slam(options);
+  ASSERT_EQ(slam.state(), SlamState::kLost);
+  const CameraIntrinsics K = Intrinsics();
+  const cv::Mat other = testing_images::Texture(1000, 800, 22);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(slam.state(), SlamState::kLost) << "image " << i;
+    EXPECT_GT(slam.map().num_points(), 0u);
+    const SlamPose pose = slam.TrackPose(FrameOf(i, Render(other, plane, Rigid3d()), K));
+    EXPECT_FALSE(pose.valid) << "image " << i;
+    EXPECT_FALSE(pose.relocalized);
+  }
+  // The fourth lost image gave the map up: a new one is to be made.
+  EXPECT_NE(slam.state(), SlamState::kLost);
+  EXPECT_EQ(slam.map().num_points(), 0u);
+  EXPECT_EQ(slam.relocalizations(), 0);
+}
+
+TEST(SlamRelocalization, OffOrWithoutDescriptorsTheLoadedMapIsNotWaitedFor) {
+  const cv::Mat texture = testing_images::Texture(1000, 800, 21);
+  const Plane plane;
+  const std::string dir = testing_util::MakeTestTempDir("reloc_off");
+  const std::string path = MakeMap(Render(texture, plane, Rigid3d()), plane, dir);
+  SlamOptions off;
+  off.map_load_path = path;
+  off.relocalization = false;
+  EXPECT_EQ(SlamSystem(off).state(), SlamState::kNotInitialized);
+  // A version 1 file has no descriptors.
+  Map bare;
+  ASSERT_TRUE(bare.Load(path).ok());
+  for (auto& [id, p] : bare.points()) p.has_descriptor = false;
+  ASSERT_TRUE(bare.Save(dir + "/bare.map").ok());
+  SlamOptions on;
+  on.map_load_path = dir + "/bare.map";
+  EXPECT_EQ(SlamSystem(on).state(), SlamState::kNotInitialized);
+}
+
+}  // namespace
+}  // namespace mbslam
