@@ -265,7 +265,7 @@ struct SlamOptions {
   int reloc_max_hamming = 50;          // descriptor match acceptance (bits of 256)
   double reloc_ratio = 0.8;            // Lowe ratio test
   int reloc_min_inliers = 20;          // inliers that place an image (count)
-  int reloc_ransac_iterations = 1000;  // EPnP RANSAC iterations at most (count)
+  int reloc_ransac_iterations = 300;   // EPnP RANSAC iterations at most (count)
   // Guided matching template given to matched points without one (px, odd; as
   // tracking.patch_size).
   int reloc_patch_px = 11;
