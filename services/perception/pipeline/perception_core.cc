@@ -51,7 +51,8 @@ int64_t PerceptionCore::UnmappedTrackAt(const Eigen::Vector2f& uv, float radius_
   int64_t best = -1;
   float best_d2 = radius_px * radius_px;
   for (const Track& t : tracker_.tracks()) {
-    if (!t.active() || t.body_id > 0 || slam_.HasPoint(t.id)) continue;
+    if (!t.active() || t.body_id > 0 || slam_.HasPoint(t.id) || slam_.IsReleasedTrack(t.id))
+      continue;
     const float d2 = (t.uv - uv).squaredNorm();
     if (d2 <= best_d2) {
       best_d2 = d2;
@@ -576,7 +577,9 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     ScopedStageTimer timer(slam_timer_);
     slam_pose = slam_.TrackPose(slam_frame);
     if (slam_pose.epipolar_assisted) counters_->Increment(counter::kPoseEpipolarAssisted);
-    if (slam_pose.relocalized && slam_pose.valid) counters_->Increment(counter::kPoseRelocalized);
+    if (slam_pose.placed_by_relocalization && slam_pose.valid) {
+      counters_->Increment(counter::kPoseRelocalized);
+    }
     // Re-found map points become tracks again (they rejoin the segmentation as static).
     for (const auto& [point_id, uv] : slam_pose.refound) {
       const int64_t track_id = tracker_.AdoptTrack(uv, 0);

@@ -136,8 +136,8 @@ class PerceptionCore : public FrameProcessor {
  private:
   // A relocalised image's match lands this close to a track the tracker already has (px).
   static constexpr float kRelocalizedTrackRadiusPx = 2.0f;
-  // The active track nearest to uv within radius_px that holds no map point and is not
-  // labelled moving, or -1.
+  // The active track nearest to uv within radius_px that holds no map point, is not
+  // labelled moving and was not released from a point as an outlier, or -1.
   int64_t UnmappedTrackAt(const Eigen::Vector2f& uv, float radius_px) const;
   std::optional<RelativeMotion> OdometryMotion(int64_t ref_frame, int64_t cur_frame) const;
   std::optional<Rigid3d> OdometryCameraPose(int64_t utime) const;

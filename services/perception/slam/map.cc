@@ -143,6 +143,9 @@ bool BytesOfHex(const std::string& hex, uint8_t* bytes, size_t n) {
 }
 
 constexpr int kMaxPatchSide = 63;  // larger patches in a file are refused (px)
+constexpr int kMinPatchSide =
+    5;  // ... and smaller ones or even sides: a patch is centred on its point
+constexpr int64_t kMaxId = int64_t{1} << 62;  // ids at or above are refused (the next id must fit)
 
 }  // namespace
 
@@ -171,7 +174,8 @@ Status Map::Save(const std::string& path) const {
           << (p.has_descriptor ? HexOf(p.descriptor.bits.data(), p.descriptor.bits.size())
                                : std::string("-"));
       const bool patch = !p.patch.empty() && p.patch.type() == CV_8UC1 &&
-                         p.patch.rows == p.patch.cols && p.patch.rows <= kMaxPatchSide &&
+                         p.patch.rows == p.patch.cols && p.patch.rows >= kMinPatchSide &&
+                         p.patch.rows <= kMaxPatchSide && p.patch.rows % 2 == 1 &&
                          p.patch.isContinuous();
       if (patch) {
         out << " " << p.patch.rows << " " << HexOf(p.patch.ptr<uint8_t>(0), p.patch.total());
@@ -209,8 +213,11 @@ Status Map::Load(const std::string& path) {
     if (!q.coeffs().allFinite() || !t.allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
       return Status::Error(path + ": keyframe " + std::to_string(k.id) + " has a bad pose");
     }
-    if (loaded.keyframes_.count(k.id))
+    if (k.id < 0 || k.id >= kMaxId)
+      return Status::Error(path + ": bad keyframe id " + std::to_string(k.id));
+    if (loaded.keyframes_.count(k.id)) {
       return Status::Error(path + ": keyframe " + std::to_string(k.id) + " twice");
+    }
     k.cam_from_world = Rigid3d(q.normalized(), t);
     k.fixed = fixed != 0;
     loaded.next_keyframe_id_ = std::max(loaded.next_keyframe_id_, k.id + 1);
@@ -229,14 +236,20 @@ Status Map::Load(const std::string& path) {
       return Status::Error(path + ": point " + std::to_string(p.id) +
                            " is not finite or has a bad grey level");
     }
-    if (loaded.points_.count(p.id))
+    if (p.id < 0 || p.id >= kMaxId)
+      return Status::Error(path + ": bad point id " + std::to_string(p.id));
+    if (loaded.points_.count(p.id)) {
       return Status::Error(path + ": point " + std::to_string(p.id) + " twice");
+    }
     p.gray = static_cast<uint8_t>(gray);
     for (size_t j = 0; j < nobs; ++j) {
       Observation o;
       if (!(in >> o.keyframe_id >> o.xy.x() >> o.xy.y())) return Status::Error(path + ": truncated observation");
       Keyframe* k = loaded.keyframe(o.keyframe_id);
-      if (!k || !o.xy.allFinite()) {
+      const bool repeated =
+          std::any_of(p.observations.begin(), p.observations.end(),
+                      [&o](const Observation& seen) { return seen.keyframe_id == o.keyframe_id; });
+      if (!k || !o.xy.allFinite() || repeated) {
         return Status::Error(path + ": point " + std::to_string(p.id) + " has a bad observation");
       }
       p.observations.push_back(o);
@@ -252,7 +265,10 @@ Status Map::Load(const std::string& path) {
         p.has_descriptor = true;
       }
       int side = 0;
-      if (!(in >> side) || side < 0 || side > kMaxPatchSide) {
+      if (!(in >> side)) return Status::Error(path + ": truncated point patch");
+      const bool bad_side =
+          side < 0 || side > kMaxPatchSide || (side > 0 && (side < kMinPatchSide || side % 2 == 0));
+      if (bad_side) {
         return Status::Error(path + ": point " + std::to_string(p.id) + " has a bad patch size");
       }
       if (side > 0) {

@@ -135,24 +135,35 @@ TEST(Map, SaveLoadKeepsDescriptorsAndPatchesAndRefusesDamage) {
       "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 9 0.1 0.2 - 0\n",  // missing keyframe
       "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2 " + hex.substr(1) +
           "g 0\n",                                                                 // bad hex
-      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2 - 3 00\n",  // short patch
+      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2 - 5 00\n",  // short patch
       "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2 - 99\n",  // patch too large
       "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2\n",       // truncated
       "mbslam_map 2\nkeyframes 1\n0 3 1000 2 0 0 0 0 0 0 1\npoints 0\n",         // not a rotation
+      "mbslam_map 2\n" + keyframe + "points 1\n-4 1 2 3 128 1 0 0.1 0.2 - 0\n",  // negative id
+      "mbslam_map 2\n" + keyframe + "points 2\n4 1 2 3 128 0 - 0\n4 1 2 3 128 0 - 0\n",  // id twice
+      "mbslam_map 2\n" + keyframe +
+          "points 1\n4 1 2 3 128 2 0 0.1 0.2 0 0.1 0.2 - 0\n",  // seen twice
+      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2 - 4 " +
+          std::string(32, '0') + "\n",                                             // even side
+      "mbslam_map 2\n" + keyframe + "points 1\n4 1 2 3 128 1 0 0.1 0.2 - 1 7f\n",  // one pixel
+      "mbslam_map 2\nkeyframes 1\n4611686018427387904 3 1000 1 0 0 0 0 0 0 1\npoints 0\n",  // id
+                                                                                            // too
+                                                                                            // large
   };
   for (size_t i = 0; i < damaged.size(); ++i) {
     Map m = loaded;
     EXPECT_FALSE(m.Load(write("bad" + std::to_string(i) + ".txt", damaged[i])).ok()) << damaged[i];
     EXPECT_EQ(m.num_points(), 2u) << "a refused file leaves the map as it was";
   }
-  // A well-formed version 2 line with a descriptor and a patch of side 1.
+  // A well-formed version 2 line with a descriptor and a 5 x 5 patch.
   Map good;
-  ASSERT_TRUE(
-      good.Load(write("good.txt", "mbslam_map 2\n" + keyframe +
-                                      "points 1\n4 1 2 3 128 1 0 0.1 0.2 " + hex + " 1 7f\n"))
-          .ok());
+  ASSERT_TRUE(good.Load(write("good.txt", "mbslam_map 2\n" + keyframe +
+                                              "points 1\n4 1 2 3 128 1 0 0.1 0.2 " + hex + " 5 7f" +
+                                              std::string(48, '1') + "\n"))
+                  .ok());
   EXPECT_EQ(good.point(4)->descriptor.bits[0], 0xaa);
   EXPECT_EQ(good.point(4)->patch.at<uint8_t>(0, 0), 0x7f);
+  EXPECT_EQ(good.point(4)->patch.at<uint8_t>(4, 4), 0x11);
 }
 
 }  // namespace

@@ -123,6 +123,7 @@ TEST(SlamRelocalization, LoadedMapPlacesATurnedAndMovedCamera) {
   const SlamPose pose = slam.TrackPose(FrameOf(0, Render(texture, plane, cam_from_world), K));
   ASSERT_TRUE(pose.valid);
   EXPECT_TRUE(pose.relocalized);
+  EXPECT_TRUE(pose.placed_by_relocalization);
   EXPECT_TRUE(pose.relocalized_map);
   EXPECT_EQ(slam.state(), SlamState::kTracking);
   EXPECT_LT(TranslationDistance(pose.cam_from_world, cam_from_world), 0.02);
@@ -161,6 +162,27 @@ TEST(SlamRelocalization, UnrelatedImagesAreNotPlacedAndTheLoadedMapIsGivenUp) {
   EXPECT_NE(slam.state(), SlamState::kLost);
   EXPECT_EQ(slam.map().num_points(), 0u);
   EXPECT_EQ(slam.relocalizations(), 0);
+}
+
+TEST(SlamRelocalization, ZeroWaitsForEver) {
+  const cv::Mat texture = testing_images::Texture(1000, 800, 21);
+  const Plane plane;
+  const std::string path = MakeMap(Render(texture, plane, Rigid3d()), plane,
+                                   testing_util::MakeTestTempDir("reloc_forever"));
+  SlamOptions options;
+  options.map_load_path = path;
+  options.reloc_loaded_max_frames = 0;
+  SlamSystem slam(options);
+  const CameraIntrinsics K = Intrinsics();
+  const cv::Mat other = Render(testing_images::Texture(1000, 800, 23), plane, Rigid3d());
+  for (int i = 0; i < 12; ++i) EXPECT_FALSE(slam.TrackPose(FrameOf(i, other, K)).valid);
+  EXPECT_EQ(slam.state(), SlamState::kLost);
+  EXPECT_GT(slam.map().num_points(), 150u);
+  // ... until the camera comes back.
+  const SlamPose pose = slam.TrackPose(FrameOf(12, Render(texture, plane, Rigid3d()), K));
+  EXPECT_TRUE(pose.valid);
+  EXPECT_TRUE(pose.placed_by_relocalization);
+  EXPECT_LT(TranslationDistance(pose.cam_from_world, Rigid3d()), 0.02);
 }
 
 TEST(SlamRelocalization, OffOrWithoutDescriptorsTheLoadedMapIsNotWaitedFor) {

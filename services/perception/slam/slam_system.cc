@@ -180,16 +180,18 @@ Status SlamSystem::SaveMap(const std::string& path) {
 
 Status SlamSystem::LoadMap(const std::string& path) {
   Flush();
+  Map loaded;
+  MBSLAM_RETURN_IF_ERROR(loaded.Load(path));
   ResolveTrajectory();  // the loaded map's keyframe and point ids start again
+  Reset();
   refine_obs_.clear();
-  MBSLAM_RETURN_IF_ERROR(map_.Load(path));
-  ++map_generation_;
-  recent_poses_.clear();
-  lost_frames_ = 0;
-  hybrid_frames_ = 0;
-  metric_ = false;
-  ground_plane_.reset();
-  relocalized_map_ = false;
+  // The saving run's image numbers mean nothing in this run, which counts from its own
+  // first image: the keyframes are moved before it (the trajectory files' "a keyframe's
+  // image is the keyframe" and back-fill's nearest keyframe compare them with this run's).
+  int64_t newest = 0;
+  for (const auto& [id, k] : loaded.keyframes()) newest = std::max(newest, k.frame_index);
+  for (auto& [id, k] : loaded.keyframes()) k.frame_index -= newest + 2;
+  map_ = std::move(loaded);
   size_t described = 0;
   for (const auto& [id, p] : map_.points()) described += p.has_descriptor ? 1 : 0;
   // A loaded map is only trusted once the camera relocalises in it: until then the
@@ -465,7 +467,10 @@ bool SlamSystem::Relocalize(const SlamFrame& frame, std::vector<Eigen::Vector3d>
     matched_inliers +=
         (*tracks)[i] < 0 && static_cast<size_t>(-1 - (*tracks)[i]) >= first && est->inliers[i];
   }
-  const bool ok = est->ok && est->num_inliers >= need;
+  // The matches must place it, not the map's own correspondences alone (RANSAC re-run
+  // on the tracks that just failed).
+  const bool ok =
+      est->ok && est->num_inliers >= need && matched_inliers >= options_.reloc_min_inliers;
   std::ostringstream what;
   what << log_name_ << " frame " << frame.frame_index << ": relocalisation "
        << (ok ? "placed the image" : "failed") << ": " << corners.size() << " corners, "
@@ -673,6 +678,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     lost_frames_ = 0;
     if (relocalized) {
       out.relocalized = true;
+      out.placed_by_relocalization = true;
       awaiting_loaded_map_ = false;
       ++relocalizations_;
     }

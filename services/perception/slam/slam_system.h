@@ -515,6 +515,8 @@ struct SlamPose {
   SlamState state = SlamState::kNotInitialized;
   bool valid = false;                      // a pose for this image exists
   bool relocalized = false;  // first pose after a re-initialisation, or placed by relocalisation
+  bool placed_by_relocalization =
+      false;  // placed by relocalisation in the map it had (not a new map)
   // The map has placed an image by relocalisation (SlamOptions::relocalization): its
   // re-found points may take the tracks already at their positions (the tracker's own
   // detections of the same corners), which ties new keyframes to the old points.
@@ -617,6 +619,9 @@ class SlamSystem {
   SlamState state() const { return state_; }
   bool initialized() const { return state_ == SlamState::kTracking || state_ == SlamState::kConfirming; }
   bool HasPoint(int64_t track_id) const { return map_.PointOfTrack(track_id) >= 0; }
+  // The track was released from its point as a pose outlier and stays unmapped
+  // (released_tracks_stay_unmapped).
+  bool IsReleasedTrack(int64_t track_id) const { return released_tracks_.count(track_id) > 0; }
   bool metric() const { return metric_; }
   // Counts the maps dropped (Reset, re-initialisation after a loss): the frame of the
   // poses changes with it.

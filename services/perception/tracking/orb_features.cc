@@ -179,9 +179,11 @@ std::vector<std::pair<int, int>> MatchOrb(const std::vector<OrbDescriptor>& quer
   std::vector<int> best_of(query.size(), -1), dist_of(query.size(), 257);
   std::vector<int> claimed(train.size(), -1);
   for (size_t i = 0; i < query.size(); ++i) {
-    if (bi[i] < 0 || b1[i] > max_hamming ||
-        static_cast<double>(b1[i]) > ratio * static_cast<double>(b2[i]))
+    // An exact tie (the ratio test lets 0 against 0 through) is ambiguous too.
+    if (bi[i] < 0 || b1[i] > max_hamming || b1[i] >= b2[i] ||
+        static_cast<double>(b1[i]) > ratio * static_cast<double>(b2[i])) {
       continue;
+    }
     const size_t j = static_cast<size_t>(bi[i]);
     if (claimed[j] >= 0) {
       const size_t other = static_cast<size_t>(claimed[j]);

@@ -46,8 +46,9 @@ void DetectOrb(const cv::Mat& image, int max_features, int fast_threshold,
                std::vector<Eigen::Vector2f>* points, std::vector<OrbDescriptor>* descriptors);
 
 // One-to-one matches (query index, train index): each query's nearest train descriptor
-// when it is within max_hamming bits and nearer than ratio x the second nearest (Lowe's
-// test); a train descriptor claimed twice goes to the nearer query.
+// when it is within max_hamming bits, nearer than ratio x the second nearest (Lowe's
+// test) and strictly nearer than it; a train descriptor claimed twice goes to the nearer
+// query.
 std::vector<std::pair<int, int>> MatchOrb(const std::vector<OrbDescriptor>& query,
                                           const std::vector<OrbDescriptor>& train, int max_hamming,
                                           double ratio);

@@ -42,6 +42,8 @@ TEST(OrbFeatures, MatchOrbIsOneToOneWithTheRatioTest) {
   ASSERT_EQ(m.size(), 2u);
   EXPECT_EQ(m[0], std::make_pair(0, 0));
   EXPECT_EQ(m[1], std::make_pair(1, 1));
+  // A query as near to two train descriptors (here both equal to it) is ambiguous.
+  EXPECT_TRUE(MatchOrb({Bits({1, 2})}, {Bits({1, 2}), Bits({1, 2})}, 50, 1.0).empty());
   // The distance limit alone.
   EXPECT_TRUE(MatchOrb(query, train, 0, 1.0).empty());
   EXPECT_TRUE(MatchOrb({}, train, 50, 0.8).empty());
