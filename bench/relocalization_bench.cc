@@ -13,21 +13,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "services/perception/tracking/orb_features.h"
+#include "services/perception/tracking/test_images.h"
 
 namespace {
 
 using mbslam::OrbDescriptor;
 
-cv::Mat Texture(int w, int h, int seed) {
-  cv::RNG rng(seed);
-  cv::Mat noise(h, w, CV_8UC1);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
-  cv::Mat fine, coarse, out;
-  cv::GaussianBlur(noise, fine, cv::Size(0, 0), 1.5);
-  cv::GaussianBlur(noise, coarse, cv::Size(0, 0), 5.0);
-  cv::addWeighted(fine, 1.0, coarse, 2.0, -128, out);
-  return out;
-}
+using mbslam::testing_images::Texture;  // band-limited random texture, corners everywhere
 
 // Up to `count` corners' descriptors of textured images (a map's described points).
 std::vector<OrbDescriptor> MapDescriptors(size_t count) {

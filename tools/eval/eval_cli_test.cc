@@ -109,6 +109,56 @@ TEST_F(EvalCli, PerturbThenAteRecoversTheKnownAnswer) {
   EXPECT_FALSE(fs::exists(Path("bad.png")));
 }
 
+// --align-est: a second run in the first run's map is scored with the first run's
+// alignment as it is; a second run in a map of its own is not rescued by it.
+TEST_F(EvalCli, AlignEstScoresARunInAnotherRunsFrame) {
+  Trajectory gt;
+  for (int i = 0; i < 120; ++i) {
+    const double s = 0.05 * i;
+    gt.push_back({1600000000000000 + i * 33333,
+                  Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(s, Eigen::Vector3d::UnitZ())),
+                          Eigen::Vector3d(3 * std::cos(s), 2 * std::sin(s), 0.2 * s))});
+  }
+  ASSERT_TRUE(WriteTumTrajectory(Path("gt.tum"), gt).ok());
+  Json perturb;
+  ASSERT_EQ(RunEval("perturb --in " + Path("gt.tum") + " --out " + Path("first.tum") +
+                        " --scale 0.5 --rot-deg 30 --axis 0,1,1 --trans 2,0,-1 --noise 0 --seed 1",
+                    &perturb),
+            0);
+  Trajectory first;
+  ASSERT_TRUE(ReadTumTrajectory(Path("first.tum"), &first).ok());
+  // The second run: the last 60 images, in the first run's map; and the same images in a
+  // map of its own (moved 1 unit and turned 10 deg).
+  const Trajectory second(first.begin() + 60, first.end());
+  Trajectory own = second;
+  const Rigid3d other_from_map(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.17, Eigen::Vector3d::UnitX())),
+      Eigen::Vector3d(1, 0, 0));
+  for (TimedPose& p : own) p.pose = other_from_map * p.pose;
+  ASSERT_TRUE(WriteTumTrajectory(Path("second.tum"), second).ok());
+  ASSERT_TRUE(WriteTumTrajectory(Path("own.tum"), own).ok());
+  const std::string align = " --gt " + Path("gt.tum") + " --align-est " + Path("first.tum") +
+                            " --align-gt " + Path("gt.tum");
+  Json in_map, elsewhere, own_sim3;
+  ASSERT_EQ(RunEval("ate --est " + Path("second.tum") + align, &in_map), 0);
+  EXPECT_LT(in_map.Find("ate_rmse_m")->AsDouble(), 1e-6);
+  EXPECT_NEAR(in_map.Find("scale")->AsDouble(), 0.5, 1e-6);  // the first run's (gt_from_est)
+  EXPECT_EQ(in_map.Find("num_pairs")->AsDouble(), 60.0);
+  ASSERT_EQ(RunEval("ate --est " + Path("own.tum") + align, &elsewhere), 0);
+  EXPECT_GT(elsewhere.Find("ate_rmse_m")->AsDouble(), 0.3);  // 1 unit is 0.5 m there
+  ASSERT_EQ(RunEval("ate --est " + Path("own.tum") + " --gt " + Path("gt.tum"), &own_sim3), 0);
+  EXPECT_LT(own_sim3.Find("ate_rmse_m")->AsDouble(), 1e-6);
+  // The other run's truth is required, and must be readable.
+  EXPECT_NE(RunEval("ate --est " + Path("second.tum") + " --gt " + Path("gt.tum") +
+                        " --align-est " + Path("first.tum"),
+                    nullptr),
+            0);
+  EXPECT_NE(RunEval("ate --est " + Path("second.tum") + " --gt " + Path("gt.tum") +
+                        " --align-est " + Path("first.tum") + " --align-gt " + Path("missing.tum"),
+                    nullptr),
+            0);
+}
+
 TEST_F(EvalCli, PerturbLabelsThenSegRecoversTheKnownAnswer) {
   {
     FILE* f = std::fopen(Path("truth.txt").c_str(), "w");

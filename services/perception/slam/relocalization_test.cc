@@ -102,13 +102,25 @@ SlamFrame FrameOf(int64_t index, const cv::Mat& image, const CameraIntrinsics& K
   return f;
 }
 
-TEST(SlamRelocalization, LoadedMapPlacesATurnedAndMovedCamera) {
+// The scene of every test: the textured plane, and the map file of camera A's view.
+struct PlaneMapFile {
   const cv::Mat texture = testing_images::Texture(1000, 800, 21);
   const Plane plane;
-  const std::string path =
-      MakeMap(Render(texture, plane, Rigid3d()), plane, testing_util::MakeTestTempDir("reloc"));
-  SlamOptions options;
-  options.map_load_path = path;
+  const std::string dir;
+  const std::string path;
+  explicit PlaneMapFile(const std::string& name)
+      : dir(testing_util::MakeTestTempDir(name)),
+        path(MakeMap(Render(texture, plane, Rigid3d()), plane, dir)) {}
+  SlamOptions Options() const {
+    SlamOptions options;
+    options.map_load_path = path;
+    return options;
+  }
+};
+
+TEST(SlamRelocalization, LoadedMapPlacesATurnedAndMovedCamera) {
+  const PlaneMapFile scene("reloc");
+  const SlamOptions options = scene.Options();
   SlamSystem slam(options);
   ASSERT_EQ(slam.state(), SlamState::kLost)
       << "a loaded map waits for the camera to relocalise in it";
@@ -120,7 +132,8 @@ TEST(SlamRelocalization, LoadedMapPlacesATurnedAndMovedCamera) {
       Eigen::AngleAxisd(4.0 * M_PI / 180.0, Eigen::Vector3d::UnitX());
   const Eigen::Vector3d centre(0.4, -0.1, 0.3);
   const Rigid3d cam_from_world(q.conjugate(), -(q.conjugate() * centre));
-  const SlamPose pose = slam.TrackPose(FrameOf(0, Render(texture, plane, cam_from_world), K));
+  const SlamPose pose =
+      slam.TrackPose(FrameOf(0, Render(scene.texture, scene.plane, cam_from_world), K));
   ASSERT_TRUE(pose.valid);
   EXPECT_TRUE(pose.relocalized);
   EXPECT_TRUE(pose.placed_by_relocalization);
@@ -140,12 +153,8 @@ TEST(SlamRelocalization, LoadedMapPlacesATurnedAndMovedCamera) {
 }
 
 TEST(SlamRelocalization, UnrelatedImagesAreNotPlacedAndTheLoadedMapIsGivenUp) {
-  const cv::Mat texture = testing_images::Texture(1000, 800, 21);
-  const Plane plane;
-  const std::string path = MakeMap(Render(texture, plane, Rigid3d()), plane,
-                                   testing_util::MakeTestTempDir("reloc_unrelated"));
-  SlamOptions options;
-  options.map_load_path = path;
+  const PlaneMapFile scene("reloc_unrelated");
+  SlamOptions options = scene.Options();
   options.reloc_loaded_max_frames = 4;
   SlamSystem slam(options);
   ASSERT_EQ(slam.state(), SlamState::kLost);
@@ -154,7 +163,7 @@ TEST(SlamRelocalization, UnrelatedImagesAreNotPlacedAndTheLoadedMapIsGivenUp) {
   for (int i = 0; i < 4; ++i) {
     EXPECT_EQ(slam.state(), SlamState::kLost) << "image " << i;
     EXPECT_GT(slam.map().num_points(), 0u);
-    const SlamPose pose = slam.TrackPose(FrameOf(i, Render(other, plane, Rigid3d()), K));
+    const SlamPose pose = slam.TrackPose(FrameOf(i, Render(other, scene.plane, Rigid3d()), K));
     EXPECT_FALSE(pose.valid) << "image " << i;
     EXPECT_FALSE(pose.relocalized);
   }
@@ -165,42 +174,35 @@ TEST(SlamRelocalization, UnrelatedImagesAreNotPlacedAndTheLoadedMapIsGivenUp) {
 }
 
 TEST(SlamRelocalization, ZeroWaitsForEver) {
-  const cv::Mat texture = testing_images::Texture(1000, 800, 21);
-  const Plane plane;
-  const std::string path = MakeMap(Render(texture, plane, Rigid3d()), plane,
-                                   testing_util::MakeTestTempDir("reloc_forever"));
-  SlamOptions options;
-  options.map_load_path = path;
+  const PlaneMapFile scene("reloc_forever");
+  SlamOptions options = scene.Options();
   options.reloc_loaded_max_frames = 0;
   SlamSystem slam(options);
   const CameraIntrinsics K = Intrinsics();
-  const cv::Mat other = Render(testing_images::Texture(1000, 800, 23), plane, Rigid3d());
+  const cv::Mat other = Render(testing_images::Texture(1000, 800, 23), scene.plane, Rigid3d());
   for (int i = 0; i < 12; ++i) EXPECT_FALSE(slam.TrackPose(FrameOf(i, other, K)).valid);
   EXPECT_EQ(slam.state(), SlamState::kLost);
   EXPECT_GT(slam.map().num_points(), 150u);
   // ... until the camera comes back.
-  const SlamPose pose = slam.TrackPose(FrameOf(12, Render(texture, plane, Rigid3d()), K));
+  const SlamPose pose =
+      slam.TrackPose(FrameOf(12, Render(scene.texture, scene.plane, Rigid3d()), K));
   EXPECT_TRUE(pose.valid);
   EXPECT_TRUE(pose.placed_by_relocalization);
   EXPECT_LT(TranslationDistance(pose.cam_from_world, Rigid3d()), 0.02);
 }
 
 TEST(SlamRelocalization, OffOrWithoutDescriptorsTheLoadedMapIsNotWaitedFor) {
-  const cv::Mat texture = testing_images::Texture(1000, 800, 21);
-  const Plane plane;
-  const std::string dir = testing_util::MakeTestTempDir("reloc_off");
-  const std::string path = MakeMap(Render(texture, plane, Rigid3d()), plane, dir);
-  SlamOptions off;
-  off.map_load_path = path;
+  const PlaneMapFile scene("reloc_off");
+  SlamOptions off = scene.Options();
   off.relocalization = false;
   EXPECT_EQ(SlamSystem(off).state(), SlamState::kNotInitialized);
-  // A version 1 file has no descriptors.
+  // A file without descriptors (as version 1 files are).
   Map bare;
-  ASSERT_TRUE(bare.Load(path).ok());
+  ASSERT_TRUE(bare.Load(scene.path).ok());
   for (auto& [id, p] : bare.points()) p.has_descriptor = false;
-  ASSERT_TRUE(bare.Save(dir + "/bare.map").ok());
+  ASSERT_TRUE(bare.Save(scene.dir + "/bare.map").ok());
   SlamOptions on;
-  on.map_load_path = dir + "/bare.map";
+  on.map_load_path = scene.dir + "/bare.map";
   EXPECT_EQ(SlamSystem(on).state(), SlamState::kNotInitialized);
 }
 
