@@ -84,35 +84,38 @@ bool ParseVector3(const std::string& text, Eigen::Vector3d* v) {
 
 // ---------------------------------------------------------------- ate
 
-Status LoadGroundTruthCamera(const mbslam::CommandLineArgs& args, const mbslam::ChannelOptions& channels,
-                             eval::Trajectory* gt, std::string* description) {
-  if (args.Has("gt")) {
-    *description = args.Get("gt");
-    return eval::ReadTumTrajectory(args.Get("gt"), gt);
+// The camera's ground truth from --PREFIX FILE.tum, --PREFIX-log LOG, --PREFIX-sequence DIR
+// or --PREFIX-tartanair pose_left.txt (prefix "gt"; "align-gt" for --align-est's run).
+Status LoadGroundTruthCamera(const mbslam::CommandLineArgs& args,
+                             const mbslam::ChannelOptions& channels, eval::Trajectory* gt,
+                             std::string* description, const std::string& prefix = "gt") {
+  if (args.Has(prefix)) {
+    *description = args.Get(prefix);
+    return eval::ReadTumTrajectory(args.Get(prefix), gt);
   }
-  if (args.Has("gt-log")) {
+  if (args.Has(prefix + "-log")) {
     eval::GroundTruthLog log;
     MBSLAM_RETURN_IF_ERROR(eval::ReadGroundTruthLog(
-        args.Get("gt-log"), args.Get("gt-channel", channels.ground_truth), &log));
+        args.Get(prefix + "-log"), args.Get("gt-channel", channels.ground_truth), &log));
     *gt = log.camera;
-    *description = args.Get("gt-log") + " (" + log.source + ")";
+    *description = args.Get(prefix + "-log") + " (" + log.source + ")";
     return Status::Ok();
   }
-  if (args.Has("gt-sequence")) {
+  if (args.Has(prefix + "-sequence")) {
     eval::SequenceFolder seq;
-    MBSLAM_RETURN_IF_ERROR(eval::ReadSequenceFolder(args.Get("gt-sequence"), &seq));
+    MBSLAM_RETURN_IF_ERROR(eval::ReadSequenceFolder(args.Get(prefix + "-sequence"), &seq));
     *gt = seq.camera;
-    *description = args.Get("gt-sequence");
+    *description = args.Get(prefix + "-sequence");
     return Status::Ok();
   }
-  if (args.Has("gt-tartanair")) {
-    *description = args.Get("gt-tartanair");
+  if (args.Has(prefix + "-tartanair")) {
+    *description = args.Get(prefix + "-tartanair");
     const int64_t frame_period_us = args.GetInt("frame-period-us", 1000000);
     if (const std::string problems = args.ParseProblems(); !problems.empty()) return Status::Error(problems);
-    return eval::ReadTartanAirPoses(args.Get("gt-tartanair"), frame_period_us, gt);
+    return eval::ReadTartanAirPoses(args.Get(prefix + "-tartanair"), frame_period_us, gt);
   }
-  return Status::Error(
-      "ate: give --gt FILE.tum, --gt-log LOG, --gt-sequence DIR or --gt-tartanair pose_left.txt");
+  return Status::Error("ate: give --" + prefix + " FILE.tum, --" + prefix + "-log LOG, --" +
+                       prefix + "-sequence DIR or --" + prefix + "-tartanair pose_left.txt");
 }
 
 int RunAte(const mbslam::CommandLineArgs& args) {
@@ -149,25 +152,16 @@ int RunAte(const mbslam::CommandLineArgs& args) {
     return Fail(st.message());
   }
 
-  // --align-est OTHER.tum with --align-gt-log LOG (or --align-gt F.tum): the alignment is
-  // computed on another run (its estimate against its truth) and applied to --est as it
-  // is: a run that relocalised in a map the other run made is scored in that map's frame.
+  // --align-est OTHER.tum with its truth (--align-gt-log LOG, --align-gt F.tum, ...): the alignment
+  // is computed on another run (its estimate against its truth) and applied to --est as it is: a
+  // run that relocalised in a map the other run made is scored in that map's frame.
   std::string alignment_label = options.alignment;
   if (args.Has("align-est")) {
     eval::Trajectory other_est, other_gt;
     st = eval::ReadTumTrajectory(args.Get("align-est"), &other_est);
-    if (st.ok()) {
-      if (args.Has("align-gt-log")) {
-        eval::GroundTruthLog truth;
-        st = eval::ReadGroundTruthLog(args.Get("align-gt-log"),
-                                      args.Get("gt-channel", channels.ground_truth), &truth);
-        other_gt = truth.camera;
-      } else if (args.Has("align-gt")) {
-        st = eval::ReadTumTrajectory(args.Get("align-gt"), &other_gt);
-      } else {
-        st = Status::Error("ate: --align-est needs --align-gt-log LOG or --align-gt FILE.tum");
-      }
-    }
+    std::string other_description;
+    if (st.ok())
+      st = LoadGroundTruthCamera(args, channels, &other_gt, &other_description, "align-gt");
     eval::AteResult other;
     if (st.ok()) st = eval::ComputeAte(other_est, other_gt, options, &other);
     if (!st.ok()) return Fail("ate: alignment from " + args.Get("align-est") + ": " + st.message());
@@ -917,7 +911,8 @@ void Usage() {
            --est F.tum | --est-log LOG [--est-channel C]
            --gt F.tum | --gt-log LOG [--gt-channel C] | --gt-sequence DIR | --gt-tartanair pose_left.txt
            [--align sim3|se3|none] [--max-dt-us N] [--rpe-delta N | --rpe-delta-us N] [--plot OUT.png] [--title T]
-           [--align-est OTHER.tum (--align-gt-log LOG | --align-gt F.tum)]: the alignment of another run
+           [--align-est OTHER.tum (--align-gt F.tum | --align-gt-log LOG | --align-gt-sequence DIR |
+            --align-gt-tartanair pose_left.txt)]: the alignment of another run
            (in the same map) against its truth, applied as it is
   seg      track misclassification (Hungarian matching)
            --pred LABELS --truth LABELS|X.tracks.txt
