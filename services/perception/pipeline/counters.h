@@ -72,6 +72,7 @@ inline constexpr const char* kTrackingLost = "tracking_lost";                   
 inline constexpr const char* kWorldMotionReplaced = "world_motion_replaced";    // SLAM's motion disagreed with the image: segmentation used its two-view estimate
 inline constexpr const char* kPoseEpipolarAssisted = "pose_epipolar_assisted";  // too few map points: pose leaned on the epipolar geometry (slam.hybrid_tracking)
 inline constexpr const char* kPoseRelocalized = "pose_relocalized";              // placed by matching ORB descriptors to the map (slam.relocalization)
+inline constexpr const char* kMapRejoined = "map_rejoined";                      // a kept lost map placed the image and was taken up again (slam.lost_maps_kept)
 inline constexpr const char* kTrackingRecovered = "tracking_recovered";         // back to OK after a loss
 inline constexpr const char* kMapPointsCulled = "map_points_culled";            // left with their culled keyframes
 inline constexpr const char* kObjectRecordsPruned = "object_records_pruned";    // per-object state of objects gone

@@ -70,6 +70,7 @@ std::vector<std::pair<int64_t, Rigid3d>> PerceptionCore::AdjustedCameraTrajector
 
 void PerceptionCore::Reset() {
   slam_.Reset();
+  slam_.ForgetLostMaps();  // starting over: the kept maps belong to the timeline left behind
   rereference_tracks_.clear();
   ground_.reset();
   occupancy_.reset();
@@ -580,6 +581,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
     if (slam_pose.placed_by_relocalization && slam_pose.valid) {
       counters_->Increment(counter::kPoseRelocalized);
     }
+    if (slam_pose.rejoined_kept_map) counters_->Increment(counter::kMapRejoined);
     // Re-found map points become tracks again (they rejoin the segmentation as static).
     for (const auto& [point_id, uv] : slam_pose.refound) {
       const int64_t track_id = tracker_.AdoptTrack(uv, 0);

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -204,6 +206,158 @@ TEST(SlamRelocalization, OffOrWithoutDescriptorsTheLoadedMapIsNotWaitedFor) {
   SlamOptions on;
   on.map_load_path = scene.dir + "/bare.map";
   EXPECT_EQ(SlamSystem(on).state(), SlamState::kNotInitialized);
+}
+
+// A map given up is kept (SlamOptions::lost_maps_kept) and taken up again when the
+// camera comes back to it during the re-initialisation: the pose is in its frame.
+TEST(SlamRelocalization, AGivenUpMapIsTakenUpAgainWhenTheCameraComesBack) {
+  const PlaneMapFile scene("reloc_kept");
+  const CameraIntrinsics K = Intrinsics();
+  const cv::Mat other = Render(testing_images::Texture(1000, 800, 24), scene.plane, Rigid3d());
+  const Eigen::Vector3d centre(0.3, 0.1, 0.2);
+  const Rigid3d back(Eigen::Quaterniond::Identity(), -centre);
+  const cv::Mat view = Render(scene.texture, scene.plane, back);
+  for (const int kept : {3, 0}) {
+    SlamOptions options = scene.Options();
+    options.reloc_loaded_max_frames = 2;
+    options.lost_maps_kept = kept;
+    SlamSystem slam(options);
+    for (int i = 0; i < 4; ++i) EXPECT_FALSE(slam.TrackPose(FrameOf(i, other, K)).valid);
+    EXPECT_EQ(slam.map().num_points(), 0u) << "the loaded map is given up";
+    EXPECT_EQ(slam.lost_maps(), kept > 0 ? 1u : 0u);
+    const SlamPose pose = slam.TrackPose(FrameOf(30, view, K));
+    if (kept == 0) {
+      EXPECT_FALSE(pose.valid) << "a map not kept cannot be come back to";
+      EXPECT_EQ(slam.maps_rejoined(), 0);
+      continue;
+    }
+    ASSERT_TRUE(pose.valid);
+    EXPECT_TRUE(pose.placed_by_relocalization);
+    EXPECT_EQ(slam.state(), SlamState::kTracking);
+    EXPECT_LT(TranslationDistance(pose.cam_from_world, back), 0.02);
+    EXPECT_GT(slam.map().num_points(), 150u);
+    EXPECT_EQ(slam.maps_rejoined(), 1);
+    EXPECT_EQ(slam.lost_maps(), 0u);
+    // The image's tracks are not judged yet: no keyframe of none (keyframe_max_frames
+    // has passed since the map's last one), one once enough are static.
+    SlamFrame frame = FrameOf(30, view, K);
+    EXPECT_FALSE(slam.UpdateMap(frame, {}).new_keyframe);
+    EXPECT_EQ(slam.map().num_keyframes(), 1u);
+    std::unordered_map<int64_t, int> labels;
+    for (int t = 0; t < options.min_tracking_inliers; ++t) {
+      SlamObservation o;
+      o.track_id = 5000 + t;
+      o.uv = Eigen::Vector2d(100.0 + 20.0 * t, 200.0);
+      o.xy = K.PixelToNormalized(o.uv);
+      o.body_id = 0;
+      frame.observations.push_back(o);
+      labels[o.track_id] = 0;
+    }
+    EXPECT_TRUE(slam.UpdateMap(frame, labels).new_keyframe);
+    EXPECT_EQ(slam.map().num_keyframes(), 2u);
+  }
+}
+
+// At exit the largest map is saved: a kept one when the current map is smaller (here
+// none: the loaded map was given up and nothing replaced it).
+TEST(SlamRelocalization, AKeptMapLargerThanTheCurrentOneIsSaved) {
+  const PlaneMapFile scene("reloc_save_kept");
+  const CameraIntrinsics K = Intrinsics();
+  const cv::Mat other = Render(testing_images::Texture(1000, 800, 26), scene.plane, Rigid3d());
+  for (const int kept : {3, 0}) {
+    SlamOptions options = scene.Options();
+    options.reloc_loaded_max_frames = 2;
+    options.lost_maps_kept = kept;
+    options.map_save_path = scene.dir + "/saved" + std::to_string(kept) + ".map";
+    {
+      SlamSystem slam(options);
+      for (int i = 0; i < 3; ++i) slam.TrackPose(FrameOf(i, other, K));
+      ASSERT_EQ(slam.map().num_keyframes(), 0u);
+    }
+    Map saved;
+    if (kept == 0) {
+      EXPECT_FALSE(saved.Load(options.map_save_path).ok()) << "nothing to save";
+      continue;
+    }
+    ASSERT_TRUE(saved.Load(options.map_save_path).ok());
+    EXPECT_GT(saved.num_points(), 150u);
+  }
+}
+
+// Points seen by a camera sliding sideways, observations only (the SLAM's tracks).
+struct SlidingScene {
+  std::vector<Eigen::Vector3d> points;
+  SlidingScene() {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), depth(4.0, 10.0);
+    while (points.size() < 600) {
+      const double z = depth(rng);
+      points.emplace_back(u(rng) * 0.8 * z, u(rng) * 0.5 * z, z);
+    }
+  }
+  SlamFrame Frame(int64_t f, const cv::Mat& image, const CameraIntrinsics& K) const {
+    SlamFrame frame = FrameOf(f, image, K);
+    const Eigen::Vector3d centre(0.05 * static_cast<double>(f), 0.0, 0.0);
+    for (size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3d p = points[i] - centre;
+      const Eigen::Vector2d uv = K.Project(p);
+      if (p.z() < 1.0 || uv.x() < 0 || uv.y() < 0 || uv.x() >= kWidth || uv.y() >= kHeight)
+        continue;
+      SlamObservation o;
+      o.track_id = static_cast<int64_t>(i);
+      o.uv = uv;
+      o.xy = p.hnormalized();
+      o.body_id = 0;
+      o.p_static = 0.9;
+      frame.observations.push_back(o);
+    }
+    return frame;
+  }
+};
+
+// A newer map that tracks gives way to an older kept map that places its image
+// (lost_map_min_inliers): a robot that started outside a loaded map continues in that
+// map's frame once it reaches it; the newer map is kept in turn.
+TEST(SlamRelocalization, ATrackingMapGivesWayToAnOlderKeptMap) {
+  const PlaneMapFile scene("reloc_give_way");
+  const CameraIntrinsics K = Intrinsics();
+  const cv::Mat other = Render(testing_images::Texture(1000, 800, 25), scene.plane, Rigid3d());
+  const SlidingScene sliding;
+  for (const bool older_kept : {true, false}) {
+    SlamOptions options = scene.Options();
+    options.reloc_loaded_max_frames = 2;
+    options.lost_maps_kept = older_kept ? 3 : 0;
+    SlamSystem slam(options);
+    int64_t f = 0;
+    for (; f < 60 && slam.state() != SlamState::kTracking; ++f)
+      slam.TrackPose(sliding.Frame(f, other, K));
+    ASSERT_EQ(slam.state(), SlamState::kTracking) << "the new map was made";
+    EXPECT_EQ(slam.maps_rejoined(), 0);
+    // The camera reaches the loaded map's place (its tracks go on in the new map).
+    SlamPose pose;
+    const int64_t arrive = f;
+    for (; f < arrive + options.lost_map_search_frames + 1 && slam.maps_rejoined() == 0; ++f) {
+      pose = slam.TrackPose(sliding.Frame(f, Render(scene.texture, scene.plane, Rigid3d()), K));
+      EXPECT_TRUE(pose.valid);
+    }
+    if (!older_kept) {
+      EXPECT_EQ(slam.maps_rejoined(), 0);
+      EXPECT_GT(TranslationDistance(pose.cam_from_world, Rigid3d()), 0.1)
+          << "still the new map's frame";
+      continue;
+    }
+    ASSERT_EQ(slam.maps_rejoined(), 1);
+    EXPECT_TRUE(pose.placed_by_relocalization);
+    EXPECT_LT(TranslationDistance(pose.cam_from_world, Rigid3d()), 0.02)
+        << "in the loaded map's frame";
+    EXPECT_GT(slam.map().num_points(), 150u);
+    EXPECT_EQ(slam.lost_maps(), 1u) << "the new map is kept in turn";
+    // It is not searched again: only older maps replace the current one.
+    for (int64_t end = f + 2 * options.lost_map_search_frames; f < end; ++f) {
+      slam.TrackPose(sliding.Frame(f, Render(scene.texture, scene.plane, Rigid3d()), K));
+    }
+    EXPECT_EQ(slam.maps_rejoined(), 1);
+  }
 }
 
 }  // namespace

@@ -80,7 +80,7 @@ SlamSystem::SlamSystem(const SlamOptions& options, std::string log_name)
 
 SlamSystem::~SlamSystem() {
   Flush();
-  if (!options_.map_save_path.empty() && map_.num_keyframes() > 0) {
+  if (!options_.map_save_path.empty()) {
     const Status s = SaveMap(options_.map_save_path);
     if (!s.ok()) MBSLAM_LOG(ERROR) << "map not saved: " << s.message();
   }
@@ -114,6 +114,91 @@ void SlamSystem::Reset() {
   ground_plane_.reset();
   awaiting_loaded_map_ = false;
   relocalized_map_ = false;
+  map_serial_ = next_map_serial_++;
+  last_lost_map_search_ = -1;
+}
+
+void SlamSystem::KeepLostMap() {
+  if (!options_.relocalization || options_.lost_maps_kept <= 0 || map_.num_keyframes() == 0) return;
+  LostMap lost;
+  for (const auto& [id, p] : map_.points()) lost.described += p.has_descriptor ? 1 : 0;
+  if (lost.described < static_cast<size_t>(options_.reloc_min_inliers)) return;
+  ResolveTrajectory();  // the entries anchored on its keyframes, before the map leaves
+  lost.map = map_;
+  // Its tracks are this run's past: the tracks that come back to it are given again by
+  // relocalisation (a track id may have moved on to another corner since).
+  for (auto& [id, p] : lost.map.points()) {
+    if (p.track_id >= 0) lost.map.ReleaseTrack(p.track_id);
+  }
+  lost.serial = map_serial_;
+  lost.metric = metric_;
+  lost.ground_plane = ground_plane_;
+  MBSLAM_LOG(INFO) << log_name_ << ": map " << lost.serial << " kept to relocalise in later ("
+                   << lost.map.num_keyframes() << " keyframes, " << lost.described
+                   << " described points)";
+  lost_maps_.push_back(std::move(lost));
+  std::sort(lost_maps_.begin(), lost_maps_.end(),
+            [](const LostMap& a, const LostMap& b) { return a.serial < b.serial; });
+  while (static_cast<int>(lost_maps_.size()) > options_.lost_maps_kept) {
+    // The newest go first: the oldest is the frame the later maps were bridged to.
+    const size_t drop = lost_maps_.size() > 1 ? lost_maps_.size() - 1 : 0;
+    MBSLAM_LOG(INFO) << log_name_ << ": kept map " << lost_maps_[drop].serial << " dropped";
+    lost_maps_.erase(lost_maps_.begin() + static_cast<std::ptrdiff_t>(drop));
+  }
+}
+
+bool SlamSystem::RejoinLostMap(const SlamFrame& frame) {
+  if (lost_maps_.empty() || !options_.relocalization || !frame.intrinsics || frame.image.empty()) {
+    return false;
+  }
+  const bool initializing =
+      state_ == SlamState::kNotInitialized || state_ == SlamState::kInitializing;
+  const bool tracking = state_ == SlamState::kTracking;
+  if (!initializing && !tracking) return false;
+  if (tracking) {
+    if (last_lost_map_search_ >= 0 &&
+        frame.frame_index - last_lost_map_search_ < options_.lost_map_search_frames) {
+      return false;
+    }
+    last_lost_map_search_ = frame.frame_index;
+  }
+  const int min_inliers = tracking ? options_.lost_map_min_inliers : options_.reloc_min_inliers;
+  for (size_t i = 0; i < lost_maps_.size(); ++i) {
+    LostMap& lost = lost_maps_[i];
+    if (tracking && lost.serial >= map_serial_) continue;  // only older maps replace it
+    std::vector<Eigen::Vector3d> X;
+    std::vector<Eigen::Vector2d> xy;
+    std::vector<int64_t> tracks, refound_ids;
+    std::vector<cv::Mat> patches;
+    std::vector<Eigen::Vector2f> refound_uv;
+    PoseEstimate est;
+    if (!Relocalize(frame, &lost.map, min_inliers, "kept map " + std::to_string(lost.serial), &X,
+                    &xy, &tracks, &patches, &refound_ids, &refound_uv, &est)) {
+      continue;
+    }
+    LostMap back = std::move(lost);
+    lost_maps_.erase(lost_maps_.begin() + static_cast<std::ptrdiff_t>(i));
+    MBSLAM_LOG(INFO) << log_name_ << " frame " << frame.frame_index << ": kept map " << back.serial
+                     << " placed the image ("
+                     << (tracking ? "it replaces map " + std::to_string(map_serial_)
+                                  : std::string("re-initialising"))
+                     << "): it is taken up again";
+    // The current map is kept in turn (a tracking one; an initialisation has none yet),
+    // and the images not posed meanwhile wait for the rejoined map's back-fill.
+    MergeBundleAdjustment(/*wait=*/true);
+    if (tracking) KeepLostMap();
+    auto unposed = std::move(unposed_);
+    Reset();
+    unposed_ = std::move(unposed);
+    map_ = std::move(back.map);
+    map_serial_ = back.serial;
+    metric_ = back.metric;
+    ground_plane_ = back.ground_plane;
+    state_ = SlamState::kLost;  // the tracking that follows relocalises in it
+    ++maps_rejoined_;
+    return true;
+  }
+  return false;
 }
 
 std::optional<double> CameraHeightAboveGround(const std::vector<Eigen::Vector3d>& points_in_cam,
@@ -175,7 +260,18 @@ void SlamSystem::RestartMap(std::optional<Bridge> bridge) {
 
 Status SlamSystem::SaveMap(const std::string& path) {
   Flush();
-  return map_.Save(path);
+  // The largest map (keyframes): the current one, or a kept one when the current map is
+  // smaller (a run that lost its map near the end saves the map it had).
+  const Map* largest = &map_;
+  for (const LostMap& lost : lost_maps_) {
+    if (lost.map.num_keyframes() > largest->num_keyframes()) largest = &lost.map;
+  }
+  if (largest->num_keyframes() == 0) return Status::Error("no map to save");
+  if (largest != &map_) {
+    MBSLAM_LOG(INFO) << log_name_ << ": the map saved is a kept one (" << largest->num_keyframes()
+                     << " keyframes; the current map has " << map_.num_keyframes() << ")";
+  }
+  return largest->Save(path);
 }
 
 Status SlamSystem::LoadMap(const std::string& path) {
@@ -419,7 +515,8 @@ void SlamSystem::FindUntrackedPoints(const SlamFrame& frame, const Rigid3d& T,
                     << unlike << " unlike, " << point_ids->size() << " re-found";
 }
 
-bool SlamSystem::Relocalize(const SlamFrame& frame, std::vector<Eigen::Vector3d>* X,
+bool SlamSystem::Relocalize(const SlamFrame& frame, Map* map, int min_inliers,
+                            const std::string& map_name, std::vector<Eigen::Vector3d>* X,
                             std::vector<Eigen::Vector2d>* xy, std::vector<int64_t>* tracks,
                             std::vector<cv::Mat>* patches, std::vector<int64_t>* refound_ids,
                             std::vector<Eigen::Vector2f>* refound_uv, PoseEstimate* est) {
@@ -428,55 +525,139 @@ bool SlamSystem::Relocalize(const SlamFrame& frame, std::vector<Eigen::Vector3d>
   // guided matching), and not behind a moving object.
   std::unordered_set<int64_t> taken(refound_ids->begin(), refound_ids->end());
   for (int64_t t : *tracks) {
-    if (t >= 0) taken.insert(map_.PointOfTrack(t));
+    if (t >= 0) taken.insert(map->PointOfTrack(t));
   }
   std::vector<int64_t> ids;
   std::vector<OrbDescriptor> descriptors;
-  for (const auto& [pid, p] : map_.points()) {
+  for (const auto& [pid, p] : map->points()) {
     if (!p.has_descriptor || p.occluded || taken.count(pid)) continue;
     ids.push_back(pid);
     descriptors.push_back(p.descriptor);
   }
-  if (static_cast<int>(ids.size() + X->size()) < options_.reloc_min_inliers) return false;
-  std::vector<Eigen::Vector2f> corners;
-  std::vector<OrbDescriptor> corner_descriptors;
-  DetectOrb(frame.image, options_.reloc_features, options_.reloc_fast_threshold, &corners,
-            &corner_descriptors);
-  const std::vector<std::pair<int, int>> matches =
-      MatchOrb(corner_descriptors, descriptors, options_.reloc_max_hamming, options_.reloc_ratio);
-  const size_t first = refound_ids->size();
-  for (const auto& [c, m] : matches) {
-    const Eigen::Vector2f& uv = corners[static_cast<size_t>(c)];
-    const int64_t pid = ids[static_cast<size_t>(m)];
-    X->push_back(map_.point(pid)->position);
-    xy->push_back(frame.intrinsics->PixelToNormalized(uv.cast<double>()));
-    tracks->push_back(-1 - static_cast<int64_t>(refound_ids->size()));
-    patches->emplace_back();
-    refound_ids->push_back(pid);
-    refound_uv->push_back(uv);
+  if (static_cast<int>(ids.size() + X->size()) < min_inliers) return false;
+  // The image's corners, once per image (it may be tried against several maps).
+  if (orb_image_.data != frame.image.data || orb_frame_ != frame.frame_index) {
+    orb_corners_.clear();
+    orb_descriptors_.clear();
+    DetectOrb(frame.image, options_.reloc_features, options_.reloc_fast_threshold, &orb_corners_,
+              &orb_descriptors_);
+    orb_image_ = frame.image;
+    orb_frame_ = frame.frame_index;
   }
+  const std::vector<Eigen::Vector2f>& corners = orb_corners_;
+  std::vector<std::pair<int, int>> matches =
+      MatchOrb(orb_descriptors_, descriptors, options_.reloc_max_hamming, options_.reloc_ratio);
+  const size_t first = refound_ids->size();
+  const size_t first_correspondence = X->size();
+  // The matches (corner, index into ids) become correspondences after the map's own.
+  const auto append_matches = [&]() {
+    X->resize(first_correspondence);
+    xy->resize(first_correspondence);
+    tracks->resize(first_correspondence);
+    patches->resize(first_correspondence);
+    refound_ids->resize(first);
+    refound_uv->resize(first);
+    for (const auto& [c, m] : matches) {
+      const Eigen::Vector2f& uv = corners[static_cast<size_t>(c)];
+      const int64_t pid = ids[static_cast<size_t>(m)];
+      X->push_back(map->point(pid)->position);
+      xy->push_back(frame.intrinsics->PixelToNormalized(uv.cast<double>()));
+      tracks->push_back(-1 - static_cast<int64_t>(refound_ids->size()));
+      patches->emplace_back();
+      refound_ids->push_back(pid);
+      refound_uv->push_back(uv);
+    }
+  };
+  const auto matched_inliers_of = [&](const PoseEstimate& e) {
+    int n = 0;
+    for (size_t i = first_correspondence; i < tracks->size() && i < e.inliers.size(); ++i)
+      n += e.inliers[i];
+    return n;
+  };
+  append_matches();
   PoseEstimatorOptions pose = options_.pose;
   pose.ransac_iterations = options_.reloc_ransac_iterations;
   *est = PoseEstimate();
-  if (static_cast<int>(X->size()) >= options_.reloc_min_inliers) {
+  if (static_cast<int>(X->size()) >= std::min(min_inliers, options_.reloc_seed_inliers)) {
     *est = EstimatePose(*X, *xy, frame.focal_px, std::nullopt, pose);
   }
-  const int need = std::max(options_.reloc_min_inliers, options_.min_tracking_inliers);
-  int matched_inliers = 0;
-  for (size_t i = 0; i < tracks->size() && i < est->inliers.size(); ++i) {
-    matched_inliers +=
-        (*tracks)[i] < 0 && static_cast<size_t>(-1 - (*tracks)[i]) >= first && est->inliers[i];
+  int matched_inliers = matched_inliers_of(*est);
+  const int seed_matches = static_cast<int>(matches.size());
+  // Search by projection: a first pose from at least reloc_seed_inliers matched inliers
+  // projects every described point, and each takes the most similar corner (ratio test)
+  // within reloc_search_radius_px of it; the image is resected again on those matches.
+  // Matching among the few corners near a projection finds the points whose descriptors
+  // changed too much to win among all (a camera come back from further along, turned).
+  if (options_.reloc_search_radius_px > 0.0 && est->ok &&
+      matched_inliers >= options_.reloc_seed_inliers) {
+    const double r = options_.reloc_search_radius_px;
+    std::unordered_map<int64_t, std::vector<int>> grid;  // cell -> corners
+    const auto cell = [r](double u, double v) {
+      return (static_cast<int64_t>(std::floor(u / r) + 1e6) << 32) +
+             static_cast<int64_t>(std::floor(v / r) + 1e6);
+    };
+    for (size_t c = 0; c < corners.size(); ++c)
+      grid[cell(corners[c].x(), corners[c].y())].push_back(static_cast<int>(c));
+    std::unordered_map<int, std::pair<int, int>>
+        best_of_corner;  // corner -> (distance, index into ids)
+    const CameraIntrinsics& K = *frame.intrinsics;
+    for (size_t m = 0; m < ids.size(); ++m) {
+      const Eigen::Vector3d pc = est->cam_from_world * map->point(ids[m])->position;
+      if (pc.z() <= 0.0) continue;
+      const Eigen::Vector2d uv = K.Project(pc);
+      if (!(uv.x() >= 0.0 && uv.y() >= 0.0 && uv.x() < K.width && uv.y() < K.height)) continue;
+      int best = 257, second = 257, best_c = -1;
+      for (int du = -1; du <= 1; ++du) {
+        for (int dv = -1; dv <= 1; ++dv) {
+          auto g = grid.find(cell(uv.x() + du * r, uv.y() + dv * r));
+          if (g == grid.end()) continue;
+          for (int c : g->second) {
+            if ((corners[static_cast<size_t>(c)].cast<double>() - uv).squaredNorm() > r * r)
+              continue;
+            const int d = HammingDistance(orb_descriptors_[static_cast<size_t>(c)], descriptors[m]);
+            if (d < best) {
+              second = best;
+              best = d;
+              best_c = c;
+            } else if (d < second) {
+              second = d;
+            }
+          }
+        }
+      }
+      if (best_c < 0 || best > options_.reloc_max_hamming ||
+          !(best < options_.reloc_ratio * second)) {
+        continue;
+      }
+      auto [it, added] = best_of_corner.try_emplace(best_c, best, static_cast<int>(m));
+      if (!added && best < it->second.first) it->second = {best, static_cast<int>(m)};
+    }
+    if (static_cast<int>(best_of_corner.size()) >= min_inliers) {
+      const std::vector<std::pair<int, int>> seed = std::move(matches);
+      matches.clear();
+      for (const auto& [c, dm] : best_of_corner) matches.emplace_back(c, dm.second);
+      std::sort(matches.begin(), matches.end());  // deterministic order
+      append_matches();
+      PoseEstimate refined = EstimatePose(*X, *xy, frame.focal_px, est->cam_from_world, pose);
+      if (refined.ok && matched_inliers_of(refined) >= matched_inliers) {
+        *est = refined;
+        matched_inliers = matched_inliers_of(refined);
+      } else {  // back to the first matches
+        matches = seed;
+        append_matches();
+      }
+    }
   }
+  const int need = std::max(min_inliers, options_.min_tracking_inliers);
   // The matches must place it, not the map's own correspondences alone (RANSAC re-run
   // on the tracks that just failed).
-  const bool ok =
-      est->ok && est->num_inliers >= need && matched_inliers >= options_.reloc_min_inliers;
+  const bool ok = est->ok && est->num_inliers >= need && matched_inliers >= min_inliers;
   std::ostringstream what;
-  what << log_name_ << " frame " << frame.frame_index << ": relocalisation "
+  what << log_name_ << " frame " << frame.frame_index << ": relocalisation in " << map_name << " "
        << (ok ? "placed the image" : "failed") << ": " << corners.size() << " corners, "
-       << descriptors.size() << " described points, " << matches.size() << " matches, inliers "
-       << est->num_inliers << " (" << matched_inliers << " of the matches) of " << X->size()
-       << " correspondences";
+       << descriptors.size() << " described points, " << seed_matches << " matches ("
+       << matches.size() << " after the search by projection), inliers " << est->num_inliers << " ("
+       << matched_inliers << " of the matches) of " << X->size() << " correspondences";
   if (ok) {
     MBSLAM_LOG(INFO) << what.str();
   } else {
@@ -487,11 +668,10 @@ bool SlamSystem::Relocalize(const SlamFrame& frame, std::vector<Eigen::Vector3d>
   for (size_t i = 0; i < tracks->size() && i < est->inliers.size(); ++i) {
     if ((*tracks)[i] >= 0 || !est->inliers[i]) continue;
     const size_t k = static_cast<size_t>(-1 - (*tracks)[i]);
-    MapPoint* p = map_.point((*refound_ids)[k]);
+    MapPoint* p = map->point((*refound_ids)[k]);
     if (p && p->patch.empty())
       ExtractPatch(frame.image, (*refound_uv)[k], options_.reloc_patch_px, &p->patch);
   }
-  relocalized_map_ = true;
   return true;
 }
 
@@ -579,6 +759,8 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
     }
   }
   while (static_cast<int>(frame_utime_.size()) > options_.backfill_max_frames + 64) frame_utime_.erase(frame_utime_.begin());
+  // A kept lost map that places this image is taken up again (lost: relocalised below).
+  const bool rejoined = RejoinLostMap(frame);
   if (state_ == SlamState::kNotInitialized || state_ == SlamState::kInitializing) {
     const bool from_earlier_pair = TryInitialize(frame, &out);
     if (!from_earlier_pair) {
@@ -651,7 +833,9 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   bool relocalized = false;
   if (!good && options_.relocalization &&
       (state_ == SlamState::kTracking || state_ == SlamState::kLost)) {
-    relocalized = Relocalize(frame, &X, &xy, &tracks, &patches, &refound_ids, &refound_uv, &est);
+    relocalized = Relocalize(frame, &map_, options_.reloc_min_inliers, "the map", &X, &xy, &tracks,
+                             &patches, &refound_ids, &refound_uv, &est);
+    if (relocalized) relocalized_map_ = true;
     good = relocalized;
   }
   if (good && state_ == SlamState::kConfirming) {
@@ -779,6 +963,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
           if (options_.bridge_ground) b.ground = ground_plane_;
           bridge = b;
         }
+        KeepLostMap();
         RestartMap(bridge);
         just_initialized_ = true;
       }
@@ -788,6 +973,7 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   out.metric = metric_;
   out.scale_to_metric = metric_ ? 1.0 : 0.0;
   out.relocalized_map = relocalized_map_;
+  out.rejoined_kept_map = rejoined && out.valid;
   last_frame_ = frame.frame_index;
   if (!out.valid) RememberUnposed(frame);
   return out;
@@ -1282,6 +1468,7 @@ SlamSystem::InitAttempt SlamSystem::AttemptInitialize(const SlamFrame& frame, Sl
   for (const SlamObservation& o : frame.observations) {
     if (current.count(o.track_id)) pair.uv[o.track_id] = o.uv;
   }
+  pair.image = frame.image;
   pair.odom = frame.odom_from_cam;
   pair.rotation_prior = frame.rotation_prior;
   pair.mean_gray = frame.mean_gray;
@@ -1393,6 +1580,8 @@ void SlamSystem::BuildInitialMap(const InitPair& pair, SlamPose* out) {
     map_.AddObservation(pid, id0, pt.xr);
     map_.AddObservation(pid, id1, pt.xn);
   }
+  // Described at once: a map lost before its next keyframe can be relocalised in.
+  if (options_.relocalization) DescribeKeyframePoints(pair.image, id1);
   // Global BA of the two views, inline.
   BaProblem problem = ExtractBa(2, true, pair.focal_px, metric_);
   const BaSummary s = SolveBa(&problem, options_.ba);
@@ -1498,6 +1687,16 @@ void SlamSystem::ApplyBridge(int64_t ref_frame, int64_t cur_frame) {
 bool SlamSystem::NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const {
   const int64_t since = frame.frame_index - last_keyframe_frame_;
   if (since < options_.keyframe_min_frames) return false;
+  // A keyframe observes the static tracks: an image with fewer than a pose needs makes
+  // none (just after a relocalisation the tracks are new, not yet judged, and a keyframe
+  // of none would hold back the next one, which triangulates against it, for
+  // keyframe_max_frames).
+  int static_tracks = 0;
+  for (const SlamObservation& o : frame.observations) {
+    auto it = labels.find(o.track_id);
+    static_tracks += it != labels.end() && it->second == 0;
+  }
+  if (static_tracks < options_.min_tracking_inliers) return false;
   if (since >= options_.keyframe_max_frames) return true;
   if (last_inliers_ < options_.keyframe_tracked_ratio * tracked_points_at_keyframe_) return true;
   // Parallax to the last keyframe (rotation compensated, via the poses).

@@ -266,11 +266,30 @@ struct SlamOptions {
   double reloc_ratio = 0.8;            // Lowe ratio test
   int reloc_min_inliers = 20;          // inliers that place an image (count)
   int reloc_ransac_iterations = 300;   // EPnP RANSAC iterations at most (count)
+  // Search by projection: a first pose with at least reloc_seed_inliers matched inliers
+  // projects every described point, which takes the most similar corner (ratio test)
+  // within reloc_search_radius_px; the image is resected again on those (0 = off).
+  double reloc_search_radius_px = 20.0;
+  int reloc_seed_inliers = 10;
   // Guided matching template given to matched points without one (px, odd; as
   // tracking.patch_size).
   int reloc_patch_px = 11;
   // Images a loaded map waits for the camera to relocalise (count; 0 = for ever).
   int reloc_loaded_max_frames = 300;
+  // Lost maps kept to come back to (an atlas of earlier maps; 0 = a lost map is dropped).
+  // A map given up after a loss (lost_frames_to_reinit) or a loaded map given up
+  // (reloc_loaded_max_frames) is kept, with its descriptors, when it has at least
+  // reloc_min_inliers described points; the newest beyond this many go (the oldest, the
+  // frame the others were bridged to, stays). Every image of a re-initialisation is tried
+  // against each kept map (oldest first); a map that places it (reloc_min_inliers) is
+  // taken up again, in its own frame. While a newer map tracks, every
+  // lost_map_search_frames images are tried against the maps older than it, and one that
+  // places the image with lost_map_min_inliers replaces it (the replaced map is kept in
+  // turn): a camera that returns to where it was, or a robot that drives into the area of
+  // a loaded map, continues in that map's frame.
+  int lost_maps_kept = 3;
+  int lost_map_search_frames = 10;  // images between searches while a newer map tracks (count)
+  int lost_map_min_inliers = 30;    // inliers that make a tracking map give way (count)
   // Images that carry a rotation prior (SlamFrame::rotation_prior) constrain the rotation
   // between keyframes (bundle adjustment) and from the last keyframe (tracking) within
   // sigma = floor + rate * elapsed time: the body's angular speed in the reference frame.
@@ -336,8 +355,13 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION(reloc_ratio > 0.0 && reloc_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GE(reloc_min_inliers, 6);
     MBSLAM_CHECK_OPTION_GT(reloc_ransac_iterations, 0);
+    MBSLAM_CHECK_OPTION_GE(reloc_search_radius_px, 0.0);
+    MBSLAM_CHECK_OPTION_GE(reloc_seed_inliers, 6);
     MBSLAM_CHECK_OPTION(reloc_patch_px >= 5 && reloc_patch_px % 2 == 1);
     MBSLAM_CHECK_OPTION_GE(reloc_loaded_max_frames, 0);
+    MBSLAM_CHECK_OPTION_GE(lost_maps_kept, 0);
+    MBSLAM_CHECK_OPTION_GE(lost_map_search_frames, 1);
+    MBSLAM_CHECK_OPTION_GE(lost_map_min_inliers, 6);
     MBSLAM_CHECK_OPTION(bridge_units == "speed" || bridge_units == "depth");
     MBSLAM_CHECK_OPTION_GE(bridge_ground_min_points, 3);
     MBSLAM_CHECK_OPTION(bridge_ground_min_share >= 0.0 && bridge_ground_min_share <= 1.0);
@@ -477,12 +501,24 @@ struct SlamOptions {
       "EPnP RANSAC inliers that place a relocalised image (count)");
     v("reloc_ransac_iterations", &reloc_ransac_iterations,
       "EPnP RANSAC iterations at most (count)");
+    v("reloc_search_radius_px", &reloc_search_radius_px,
+      "search by projection: from a first pose, each described point takes the most similar corner "
+      "within this distance of its projection, and the image is resected again (px; 0 = off)");
+    v("reloc_seed_inliers", &reloc_seed_inliers,
+      "matched inliers of the first pose that start the search by projection (count)");
     v("reloc_patch_px", &reloc_patch_px,
       "guided matching template given to relocalised points without one, odd (px; as "
       "tracking.patch_size)");
     v("reloc_loaded_max_frames", &reloc_loaded_max_frames,
       "images a loaded map waits for the camera to relocalise before a new map is made (count; 0 = "
       "for ever)");
+    v("lost_maps_kept", &lost_maps_kept,
+      "lost or given-up maps kept to relocalise in again: tried at every image of a "
+      "re-initialisation, and by a newer tracking map (count; 0 = dropped)");
+    v("lost_map_search_frames", &lost_map_search_frames,
+      "images between the tries of the older kept maps while a newer map tracks (count)");
+    v("lost_map_min_inliers", &lost_map_min_inliers,
+      "relocalisation inliers with which an older kept map replaces the tracking one (count)");
   }
 };
 
@@ -521,6 +557,8 @@ struct SlamPose {
   // re-found points may take the tracks already at their positions (the tracker's own
   // detections of the same corners), which ties new keyframes to the old points.
   bool relocalized_map = false;
+  // A kept lost map (SlamOptions::lost_maps_kept) placed this image and is the map now.
+  bool rejoined_kept_map = false;
   Rigid3d cam_from_world;
   Matrix6d covariance = Matrix6d::Zero();  // left perturbation [t; r] of cam_from_world
   int num_inliers = 0;
@@ -643,7 +681,13 @@ class SlamSystem {
   double last_ba_seconds() const { return last_ba_seconds_; }
   // Images placed by relocalisation (SlamOptions::relocalization) so far.
   int64_t relocalizations() const { return relocalizations_; }
+  // Kept lost maps taken up again (SlamOptions::lost_maps_kept) so far, and kept now.
+  int64_t maps_rejoined() const { return maps_rejoined_; }
+  size_t lost_maps() const { return lost_maps_.size(); }
+  void ForgetLostMaps() { lost_maps_.clear(); }
 
+  // Saves the largest map by keyframes (the current one, or a kept lost map larger than
+  // it); an error when there is none.
   Status SaveMap(const std::string& path);
   Status LoadMap(const std::string& path);
 
@@ -661,6 +705,7 @@ class SlamSystem {
     int64_t utime = 0;
     std::unordered_map<int64_t, Eigen::Vector2d> xy;
     std::unordered_map<int64_t, Eigen::Vector2d> uv;
+    cv::Mat image;  // its image (shallow copy): the descriptors of the map's first points
     std::optional<Rigid3d> odom;
     std::optional<CameraRotationPrior> rotation_prior;
     uint8_t mean_gray = 128;
@@ -723,13 +768,16 @@ class SlamSystem {
                            std::vector<int64_t>* point_ids, std::vector<Eigen::Vector2d>* xy,
                            std::vector<Eigen::Vector2f>* uv);
   // Relocalisation (SlamOptions::relocalization): ORB corners of the image matched to the
-  // described map points not already among the correspondences are appended to them
-  // (as re-found points: `tracks` -1 - k for refound_ids[k]), and the image is resected
-  // on all of them by EPnP RANSAC. True when at least reloc_min_inliers are inliers.
-  bool Relocalize(const SlamFrame& frame, std::vector<Eigen::Vector3d>* X,
-                  std::vector<Eigen::Vector2d>* xy, std::vector<int64_t>* tracks,
-                  std::vector<cv::Mat>* patches, std::vector<int64_t>* refound_ids,
-                  std::vector<Eigen::Vector2f>* refound_uv, PoseEstimate* est);
+  // described points of `map` (map_, or a kept lost map) not already among the
+  // correspondences are appended to them (as re-found points: `tracks` -1 - k for
+  // refound_ids[k]), and the image is resected on all of them by EPnP RANSAC. True when
+  // at least `min_inliers` (and min_tracking_inliers) are inliers, `min_inliers` of them
+  // matches; their points then get a guided matching patch when they have none.
+  bool Relocalize(const SlamFrame& frame, Map* map, int min_inliers, const std::string& map_name,
+                  std::vector<Eigen::Vector3d>* X, std::vector<Eigen::Vector2d>* xy,
+                  std::vector<int64_t>* tracks, std::vector<cv::Mat>* patches,
+                  std::vector<int64_t>* refound_ids, std::vector<Eigen::Vector2f>* refound_uv,
+                  PoseEstimate* est);
   // The `count` keyframes whose cameras are nearest the camera of `cam_from_world` among
   // those looking the same way (optical axes within 60 deg).
   std::vector<int64_t> NearestKeyframes(const Rigid3d& cam_from_world, int count) const;
@@ -841,6 +889,33 @@ class SlamSystem {
   bool relocalized_map_ = false;
   int64_t relocalizations_ = 0;
   int64_t map_generation_ = 0;
+  // Lost maps kept to relocalise in again (SlamOptions::lost_maps_kept), oldest first.
+  // `serial` orders maps by when they were begun (map_serial_ is the current map's).
+  struct LostMap {
+    Map map;
+    int64_t serial = 0;
+    bool metric = false;
+    std::optional<Eigen::Vector4d> ground_plane;
+    size_t described = 0;
+  };
+  std::vector<LostMap> lost_maps_;
+  // Relocalize's ORB corners of the last image it saw (image, frame index).
+  cv::Mat orb_image_;
+  int64_t orb_frame_ = -1;
+  std::vector<Eigen::Vector2f> orb_corners_;
+  std::vector<OrbDescriptor> orb_descriptors_;
+  int64_t map_serial_ = 0;
+  int64_t next_map_serial_ = 1;
+  int64_t last_lost_map_search_ = -1;  // image of the last search while tracking
+  int64_t maps_rejoined_ = 0;
+  // Keeps the current map (before it is dropped) among lost_maps_ if it can be
+  // relocalised in; the newest beyond lost_maps_kept are dropped, never the oldest.
+  void KeepLostMap();
+  // Tries `frame` against the kept maps (re-initialising: all of them, every image;
+  // tracking: those older than the current map, every lost_map_search_frames images).
+  // On a placement the current map is kept (when tracking) and the placing map is taken
+  // up again, lost: the tracking that follows relocalises in it. True then.
+  bool RejoinLostMap(const SlamFrame& frame);
   bool rotation_prior_active_ = false;  // this map was initialised with the rotation prior and keeps it
 
   // After a loss the next map continues the previous world frame: the pose is carried
