@@ -323,24 +323,34 @@ TEST(SlamRelocalization, ATrackingMapGivesWayToAnOlderKeptMap) {
   const CameraIntrinsics K = Intrinsics();
   const cv::Mat other = Render(testing_images::Texture(1000, 800, 25), scene.plane, Rigid3d());
   const SlidingScene sliding;
-  for (const bool older_kept : {true, false}) {
+  // Kept and searched; not kept; kept, but asking more inliers than there are; kept, but
+  // searched again only after the arrival window (the first search was on arriving in
+  // tracking, before the camera reached the place).
+  enum Case { kKept, kNotKept, kTooFewInliers, kLongInterval };
+  for (const Case c : {kKept, kNotKept, kTooFewInliers, kLongInterval}) {
+    SCOPED_TRACE(static_cast<int>(c));
     SlamOptions options = scene.Options();
     options.reloc_loaded_max_frames = 2;
-    options.lost_maps_kept = older_kept ? 3 : 0;
+    options.lost_maps_kept = c == kNotKept ? 0 : 3;
+    if (c == kTooFewInliers) options.lost_map_min_inliers = 100000;
+    if (c == kLongInterval) options.lost_map_search_frames = 50;
+    const int window = 11;  // images at the place: a search every 10 finds it
     SlamSystem slam(options);
     int64_t f = 0;
-    for (; f < 60 && slam.state() != SlamState::kTracking; ++f)
+    for (; f < 60 && slam.state() != SlamState::kTracking; ++f) {
       slam.TrackPose(sliding.Frame(f, other, K));
+    }
     ASSERT_EQ(slam.state(), SlamState::kTracking) << "the new map was made";
+    slam.TrackPose(sliding.Frame(f++, other, K));  // the first search: nothing there
     EXPECT_EQ(slam.maps_rejoined(), 0);
     // The camera reaches the loaded map's place (its tracks go on in the new map).
     SlamPose pose;
     const int64_t arrive = f;
-    for (; f < arrive + options.lost_map_search_frames + 1 && slam.maps_rejoined() == 0; ++f) {
+    for (; f < arrive + window && slam.maps_rejoined() == 0; ++f) {
       pose = slam.TrackPose(sliding.Frame(f, Render(scene.texture, scene.plane, Rigid3d()), K));
       EXPECT_TRUE(pose.valid);
     }
-    if (!older_kept) {
+    if (c != kKept) {
       EXPECT_EQ(slam.maps_rejoined(), 0);
       EXPECT_GT(TranslationDistance(pose.cam_from_world, Rigid3d()), 0.1)
           << "still the new map's frame";
@@ -348,6 +358,7 @@ TEST(SlamRelocalization, ATrackingMapGivesWayToAnOlderKeptMap) {
     }
     ASSERT_EQ(slam.maps_rejoined(), 1);
     EXPECT_TRUE(pose.placed_by_relocalization);
+    EXPECT_TRUE(pose.rejoined_kept_map);
     EXPECT_LT(TranslationDistance(pose.cam_from_world, Rigid3d()), 0.02)
         << "in the loaded map's frame";
     EXPECT_GT(slam.map().num_points(), 150u);
@@ -358,6 +369,30 @@ TEST(SlamRelocalization, ATrackingMapGivesWayToAnOlderKeptMap) {
     }
     EXPECT_EQ(slam.maps_rejoined(), 1);
   }
+}
+
+// The search by projection finds the points whose descriptors lost among all the
+// corners: a camera 0.7 m nearer the plane and turned 12 deg is placed only with it.
+TEST(SlamRelocalization, SearchByProjectionFindsMorePoints) {
+  const PlaneMapFile scene("reloc_search");
+  const CameraIntrinsics K = Intrinsics();
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(12.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+  const Eigen::Vector3d centre(0.3, 0.0, 0.7);
+  const Rigid3d cam_from_world(q.conjugate(), -(q.conjugate() * centre));
+  const cv::Mat view = Render(scene.texture, scene.plane, cam_from_world);
+  SlamPose with_search, without;
+  for (const double radius : {20.0, 0.0}) {
+    SlamOptions options = scene.Options();
+    options.reloc_search_radius_px = radius;
+    SlamSystem slam(options);
+    (radius > 0.0 ? with_search : without) = slam.TrackPose(FrameOf(0, view, K));
+  }
+  // Globally too few matches agree (0 placed); around the first pose's projections
+  // enough do.
+  EXPECT_FALSE(without.valid);
+  ASSERT_TRUE(with_search.valid);
+  EXPECT_LT(TranslationDistance(with_search.cam_from_world, cam_from_world), 0.02);
+  EXPECT_GE(with_search.refound.size(), 40u);
 }
 
 }  // namespace

@@ -80,7 +80,10 @@ SlamSystem::SlamSystem(const SlamOptions& options, std::string log_name)
 
 SlamSystem::~SlamSystem() {
   Flush();
-  if (!options_.map_save_path.empty()) {
+  const bool any_map = map_.num_keyframes() > 0 ||
+                       std::any_of(lost_maps_.begin(), lost_maps_.end(),
+                                   [](const LostMap& m) { return m.map.num_keyframes() > 0; });
+  if (!options_.map_save_path.empty() && any_map) {
     const Status s = SaveMap(options_.map_save_path);
     if (!s.ok()) MBSLAM_LOG(ERROR) << "map not saved: " << s.message();
   }
@@ -127,8 +130,10 @@ void SlamSystem::KeepLostMap() {
   lost.map = map_;
   // Its tracks are this run's past: the tracks that come back to it are given again by
   // relocalisation (a track id may have moved on to another corner since).
+  // Nor is what hid its points then still in front of them.
   for (auto& [id, p] : lost.map.points()) {
     if (p.track_id >= 0) lost.map.ReleaseTrack(p.track_id);
+    p.occluded = false;
   }
   lost.serial = map_serial_;
   lost.metric = metric_;
@@ -183,17 +188,19 @@ bool SlamSystem::RejoinLostMap(const SlamFrame& frame) {
                      << (tracking ? "it replaces map " + std::to_string(map_serial_)
                                   : std::string("re-initialising"))
                      << "): it is taken up again";
-    // The current map is kept in turn (a tracking one; an initialisation has none yet),
-    // and the images not posed meanwhile wait for the rejoined map's back-fill.
+    // The current map is kept in turn (a tracking one; an initialisation has none yet).
+    // The images not posed meanwhile stay so: their tracks hold no point of it.
     MergeBundleAdjustment(/*wait=*/true);
     if (tracking) KeepLostMap();
-    auto unposed = std::move(unposed_);
     Reset();
-    unposed_ = std::move(unposed);
     map_ = std::move(back.map);
     map_serial_ = back.serial;
     metric_ = back.metric;
     ground_plane_ = back.ground_plane;
+    // Its keyframes hold none of the tracks: the next image with enough static tracks
+    // makes one (keyframe_max_frames have passed since its last).
+    if (const Keyframe* last = map_.LastKeyframe()) last_keyframe_frame_ = last->frame_index;
+    tracked_points_at_keyframe_ = 0;
     state_ = SlamState::kLost;  // the tracking that follows relocalises in it
     ++maps_rejoined_;
     return true;

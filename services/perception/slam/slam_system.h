@@ -355,7 +355,7 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION(reloc_ratio > 0.0 && reloc_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GE(reloc_min_inliers, 6);
     MBSLAM_CHECK_OPTION_GT(reloc_ransac_iterations, 0);
-    MBSLAM_CHECK_OPTION_GE(reloc_search_radius_px, 0.0);
+    MBSLAM_CHECK_OPTION(reloc_search_radius_px == 0.0 || reloc_search_radius_px >= 1.0);
     MBSLAM_CHECK_OPTION_GE(reloc_seed_inliers, 6);
     MBSLAM_CHECK_OPTION(reloc_patch_px >= 5 && reloc_patch_px % 2 == 1);
     MBSLAM_CHECK_OPTION_GE(reloc_loaded_max_frames, 0);
@@ -503,7 +503,8 @@ struct SlamOptions {
       "EPnP RANSAC iterations at most (count)");
     v("reloc_search_radius_px", &reloc_search_radius_px,
       "search by projection: from a first pose, each described point takes the most similar corner "
-      "within this distance of its projection, and the image is resected again (px; 0 = off)");
+      "within this distance of its projection, and the image is resected again (px, >= 1; 0 = "
+      "off)");
     v("reloc_seed_inliers", &reloc_seed_inliers,
       "matched inliers of the first pose that start the search by projection (count)");
     v("reloc_patch_px", &reloc_patch_px,
