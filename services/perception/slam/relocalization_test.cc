@@ -238,9 +238,10 @@ TEST(SlamRelocalization, AGivenUpMapIsTakenUpAgainWhenTheCameraComesBack) {
     EXPECT_GT(slam.map().num_points(), 150u);
     EXPECT_EQ(slam.maps_rejoined(), 1);
     EXPECT_EQ(slam.lost_maps(), 0u);
-    // The image's tracks are not judged yet: no keyframe of none (keyframe_max_frames
-    // has passed since the map's last one), one once enough are static.
-    SlamFrame frame = FrameOf(30, view, K);
+    // The image's tracks are not judged yet: no keyframe of none (keyframe_min_frames
+    // have passed since the rejoin), one once enough are static.
+    SlamFrame frame = FrameOf(30 + options.keyframe_min_frames, view, K);
+    ASSERT_TRUE(slam.TrackPose(frame).valid);
     EXPECT_FALSE(slam.UpdateMap(frame, {}).new_keyframe);
     EXPECT_EQ(slam.map().num_keyframes(), 1u);
     std::unordered_map<int64_t, int> labels;
