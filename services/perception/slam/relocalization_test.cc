@@ -372,6 +372,36 @@ TEST(SlamRelocalization, ATrackingMapGivesWayToAnOlderKeptMap) {
   }
 }
 
+// Beyond lost_maps_kept the newest kept map goes, not the oldest: a map made after the
+// loaded one was given up, then lost itself, is dropped, and the loaded map is still
+// there to come back to.
+TEST(SlamRelocalization, TheOldestKeptMapStays) {
+  const PlaneMapFile scene("reloc_oldest");
+  const CameraIntrinsics K = Intrinsics();
+  const cv::Mat other = Render(testing_images::Texture(1000, 800, 27), scene.plane, Rigid3d());
+  const cv::Mat dark = Render(testing_images::Texture(1000, 800, 28), scene.plane, Rigid3d());
+  const SlidingScene sliding;
+  SlamOptions options = scene.Options();
+  options.reloc_loaded_max_frames = 2;
+  options.lost_maps_kept = 1;
+  SlamSystem slam(options);
+  int64_t f = 0;
+  for (; f < 60 && slam.state() != SlamState::kTracking; ++f)
+    slam.TrackPose(sliding.Frame(f, other, K));
+  ASSERT_EQ(slam.state(), SlamState::kTracking);
+  ASSERT_EQ(slam.lost_maps(), 1u) << "the loaded map, given up";
+  // The new map is lost: images of neither map, without tracks.
+  for (int i = 0; i < options.lost_frames_to_reinit; ++i)
+    EXPECT_FALSE(slam.TrackPose(FrameOf(f++, dark, K)).valid);
+  EXPECT_EQ(slam.map().num_keyframes(), 0u) << "re-initialising";
+  EXPECT_EQ(slam.lost_maps(), 1u) << "one kept: the new map went";
+  const SlamPose pose =
+      slam.TrackPose(FrameOf(f, Render(scene.texture, scene.plane, Rigid3d()), K));
+  ASSERT_TRUE(pose.valid) << "the loaded map is still there";
+  EXPECT_LT(TranslationDistance(pose.cam_from_world, Rigid3d()), 0.02);
+  EXPECT_EQ(slam.maps_rejoined(), 1);
+}
+
 // The search by projection finds the points whose descriptors lost among all the
 // corners: a camera 0.7 m nearer the plane and turned 12 deg is placed only with it.
 TEST(SlamRelocalization, SearchByProjectionFindsMorePoints) {
