@@ -402,6 +402,22 @@ TEST(SlamRelocalization, TheOldestKeptMapStays) {
   EXPECT_EQ(slam.maps_rejoined(), 1);
 }
 
+// A map without described points (no images: nothing to describe) cannot be
+// relocalised in, so it is not kept when it is lost.
+TEST(SlamRelocalization, AMapWithoutDescriptorsIsNotKept) {
+  const CameraIntrinsics K = Intrinsics();
+  const SlidingScene sliding;
+  SlamSystem slam{SlamOptions()};
+  int64_t f = 0;
+  for (; f < 60 && slam.state() != SlamState::kTracking; ++f)
+    slam.TrackPose(sliding.Frame(f, cv::Mat(), K));
+  ASSERT_EQ(slam.state(), SlamState::kTracking);
+  for (int i = 0; i < SlamOptions().lost_frames_to_reinit; ++i)
+    slam.TrackPose(FrameOf(f++, cv::Mat(), K));
+  EXPECT_EQ(slam.map().num_keyframes(), 0u) << "lost and given up";
+  EXPECT_EQ(slam.lost_maps(), 0u);
+}
+
 // The search by projection finds the points whose descriptors lost among all the
 // corners: a camera 0.7 m nearer the plane and turned 12 deg is placed only with it.
 TEST(SlamRelocalization, SearchByProjectionFindsMorePoints) {
