@@ -285,4 +285,10 @@ Status Map::Load(const std::string& path) {
   return Status::Ok();
 }
 
+size_t Map::num_described_points() const {
+  size_t n = 0;
+  for (const auto& [id, p] : points_) n += p.has_descriptor ? 1 : 0;
+  return n;
+}
+
 }  // namespace mbslam

@@ -100,6 +100,8 @@ class Map {
   const Keyframe* LastKeyframe() const;
   size_t num_keyframes() const { return keyframes_.size(); }
   size_t num_points() const { return points_.size(); }
+  // Points with an ORB descriptor (what relocalisation can match).
+  size_t num_described_points() const;
 
   // Multiplies every position by s (gauge change, e.g. to metric units).
   void Rescale(double s);

@@ -107,6 +107,8 @@ TEST(Map, SaveLoadKeepsDescriptorsAndPatchesAndRefusesDamage) {
   ASSERT_TRUE(map.Save(dir + "/map.txt").ok());
   Map loaded;
   ASSERT_TRUE(loaded.Load(dir + "/map.txt").ok());
+  EXPECT_EQ(map.num_described_points(), 1u);
+  EXPECT_EQ(loaded.num_described_points(), 1u);
   ASSERT_TRUE(loaded.point(a)->has_descriptor);
   EXPECT_EQ(loaded.point(a)->descriptor.bits, described.descriptor.bits);
   ASSERT_EQ(loaded.point(a)->patch.rows, 11);

@@ -372,6 +372,44 @@ TEST(SlamRelocalization, ATrackingMapGivesWayToAnOlderKeptMap) {
   }
 }
 
+// The relocalisation by which a kept map replaces the tracking one places that image
+// itself: the image is not relocalised a second time in the map taken up, which would
+// ask reloc_min_inliers where the search asked lost_map_min_inliers (and cost a second
+// matching).
+TEST(SlamRelocalization, TheImageThatRejoinsAMapIsPlacedByThatSearch) {
+  const PlaneMapFile scene("reloc_hand_over");
+  const CameraIntrinsics K = Intrinsics();
+  Map loaded;
+  ASSERT_TRUE(loaded.Load(scene.path).ok());
+  const cv::Mat other = Render(testing_images::Texture(1000, 800, 26), scene.plane, Rigid3d());
+  const SlidingScene sliding;
+  const Rigid3d back(Eigen::Quaterniond::Identity(), -Eigen::Vector3d(0.3, 0.1, 0.2));
+  SlamOptions options = scene.Options();
+  options.reloc_loaded_max_frames = 2;
+  options.lost_map_min_inliers = 6;
+  // Enough to keep the loaded map, more than one image of it can match.
+  options.reloc_min_inliers = static_cast<int>(loaded.num_described_points());
+  SlamSystem slam(options);
+  int64_t f = 0;
+  for (; f < 60 && slam.state() != SlamState::kTracking; ++f) {
+    slam.TrackPose(sliding.Frame(f, other, K));
+  }
+  ASSERT_EQ(slam.state(), SlamState::kTracking) << "the new map was made";
+  ASSERT_EQ(slam.lost_maps(), 1u) << "the loaded map is kept";
+  SlamPose pose;
+  for (const int64_t end = f + 11; f < end && slam.maps_rejoined() == 0; ++f) {
+    pose = slam.TrackPose(sliding.Frame(f, Render(scene.texture, scene.plane, back), K));
+  }
+  ASSERT_EQ(slam.maps_rejoined(), 1);
+  EXPECT_GE(pose.num_inliers, options.lost_map_min_inliers);
+  EXPECT_LT(pose.num_inliers, options.reloc_min_inliers);
+  EXPECT_TRUE(pose.valid);
+  EXPECT_TRUE(pose.placed_by_relocalization);
+  EXPECT_TRUE(pose.rejoined_kept_map);
+  EXPECT_EQ(slam.state(), SlamState::kTracking);
+  EXPECT_LT(TranslationDistance(pose.cam_from_world, back), 0.02) << "in the loaded map's frame";
+}
+
 // Beyond lost_maps_kept the newest kept map goes, not the oldest: a map made after the
 // loaded one was given up, then lost itself, is dropped, and the loaded map is still
 // there to come back to.

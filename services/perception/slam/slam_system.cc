@@ -123,9 +123,9 @@ void SlamSystem::Reset() {
 
 void SlamSystem::KeepLostMap() {
   if (!options_.relocalization || options_.lost_maps_kept <= 0 || map_.num_keyframes() == 0) return;
+  const size_t described = map_.num_described_points();
+  if (described < static_cast<size_t>(options_.reloc_min_inliers)) return;
   LostMap lost;
-  for (const auto& [id, p] : map_.points()) lost.described += p.has_descriptor ? 1 : 0;
-  if (lost.described < static_cast<size_t>(options_.reloc_min_inliers)) return;
   ResolveTrajectory();  // the entries anchored on its keyframes, before the map leaves
   lost.map = map_;
   // Its tracks are this run's past: the tracks that come back to it are given again by
@@ -139,7 +139,7 @@ void SlamSystem::KeepLostMap() {
   lost.metric = metric_;
   lost.ground_plane = ground_plane_;
   MBSLAM_LOG(INFO) << log_name_ << ": map " << lost.serial << " kept to relocalise in later ("
-                   << lost.map.num_keyframes() << " keyframes, " << lost.described
+                   << lost.map.num_keyframes() << " keyframes, " << described
                    << " described points)";
   lost_maps_.push_back(std::move(lost));
   std::sort(lost_maps_.begin(), lost_maps_.end(),
@@ -153,6 +153,7 @@ void SlamSystem::KeepLostMap() {
 }
 
 bool SlamSystem::RejoinLostMap(const SlamFrame& frame) {
+  rejoin_placement_.reset();
   if (lost_maps_.empty() || !options_.relocalization || !frame.intrinsics || frame.image.empty()) {
     return false;
   }
@@ -171,14 +172,11 @@ bool SlamSystem::RejoinLostMap(const SlamFrame& frame) {
   for (size_t i = 0; i < lost_maps_.size(); ++i) {
     LostMap& lost = lost_maps_[i];
     if (tracking && lost.serial >= map_serial_) continue;  // only older maps replace it
-    std::vector<Eigen::Vector3d> X;
-    std::vector<Eigen::Vector2d> xy;
-    std::vector<int64_t> tracks, refound_ids;
-    std::vector<cv::Mat> patches;
-    std::vector<Eigen::Vector2f> refound_uv;
-    PoseEstimate est;
-    if (!Relocalize(frame, &lost.map, min_inliers, "kept map " + std::to_string(lost.serial), &X,
-                    &xy, &tracks, &patches, &refound_ids, &refound_uv, &est)) {
+    Placement placed;
+    placed.frame_index = frame.frame_index;
+    if (!Relocalize(frame, &lost.map, min_inliers, "kept map " + std::to_string(lost.serial),
+                    &placed.X, &placed.xy, &placed.tracks, &placed.patches, &placed.refound_ids,
+                    &placed.refound_uv, &placed.est)) {
       continue;
     }
     LostMap back = std::move(lost);
@@ -204,7 +202,8 @@ bool SlamSystem::RejoinLostMap(const SlamFrame& frame) {
     // against 0.16 m.
     last_keyframe_frame_ = frame.frame_index;
     tracked_points_at_keyframe_ = std::numeric_limits<int>::max() / 2;
-    state_ = SlamState::kLost;  // the tracking that follows relocalises in it
+    state_ = SlamState::kLost;  // the tracking that follows is placed by this relocalisation
+    rejoin_placement_ = std::move(placed);
     ++maps_rejoined_;
     return true;
   }
@@ -298,8 +297,7 @@ Status SlamSystem::LoadMap(const std::string& path) {
   for (const auto& [id, k] : loaded.keyframes()) newest = std::max(newest, k.frame_index);
   for (auto& [id, k] : loaded.keyframes()) k.frame_index -= newest + 2;
   map_ = std::move(loaded);
-  size_t described = 0;
-  for (const auto& [id, p] : map_.points()) described += p.has_descriptor ? 1 : 0;
+  const size_t described = map_.num_described_points();
   // A loaded map is only trusted once the camera relocalises in it: until then the
   // service is lost in it (relocalisation) for at most reloc_loaded_max_frames images.
   // Without descriptors (an older file) it cannot relocalise: the first initialisation
@@ -600,53 +598,23 @@ bool SlamSystem::Relocalize(const SlamFrame& frame, Map* map, int min_inliers,
   // changed too much to win among all (a camera come back from further along, turned).
   if (options_.reloc_search_radius_px > 0.0 && est->ok &&
       matched_inliers >= options_.reloc_seed_inliers) {
-    const double r = options_.reloc_search_radius_px;
-    std::unordered_map<int64_t, std::vector<int>> grid;  // cell -> corners
-    const auto cell = [r](double u, double v) {
-      return (static_cast<int64_t>(std::floor(u / r) + 1e6) << 32) +
-             static_cast<int64_t>(std::floor(v / r) + 1e6);
-    };
-    for (size_t c = 0; c < corners.size(); ++c)
-      grid[cell(corners[c].x(), corners[c].y())].push_back(static_cast<int>(c));
-    std::unordered_map<int, std::pair<int, int>>
-        best_of_corner;  // corner -> (distance, index into ids)
     const CameraIntrinsics& K = *frame.intrinsics;
+    std::vector<Eigen::Vector2f> projected(ids.size(), Eigen::Vector2f::Constant(NAN));
     for (size_t m = 0; m < ids.size(); ++m) {
       const Eigen::Vector3d pc = est->cam_from_world * map->point(ids[m])->position;
       if (pc.z() <= 0.0) continue;
       const Eigen::Vector2d uv = K.Project(pc);
-      if (!(uv.x() >= 0.0 && uv.y() >= 0.0 && uv.x() < K.width && uv.y() < K.height)) continue;
-      int best = 257, second = 257, best_c = -1;
-      for (int du = -1; du <= 1; ++du) {
-        for (int dv = -1; dv <= 1; ++dv) {
-          auto g = grid.find(cell(uv.x() + du * r, uv.y() + dv * r));
-          if (g == grid.end()) continue;
-          for (int c : g->second) {
-            if ((corners[static_cast<size_t>(c)].cast<double>() - uv).squaredNorm() > r * r)
-              continue;
-            const int d = HammingDistance(orb_descriptors_[static_cast<size_t>(c)], descriptors[m]);
-            if (d < best) {
-              second = best;
-              best = d;
-              best_c = c;
-            } else if (d < second) {
-              second = d;
-            }
-          }
-        }
-      }
-      if (best_c < 0 || best > options_.reloc_max_hamming ||
-          !(best < options_.reloc_ratio * second)) {
-        continue;
-      }
-      auto [it, added] = best_of_corner.try_emplace(best_c, best, static_cast<int>(m));
-      if (!added && best < it->second.first) it->second = {best, static_cast<int>(m)};
+      if (uv.x() >= 0.0 && uv.y() >= 0.0 && uv.x() < K.width && uv.y() < K.height)
+        projected[m] = uv.cast<float>();
     }
-    if (static_cast<int>(best_of_corner.size()) >= min_inliers) {
+    const std::vector<std::pair<int, int>> found = MatchOrbWithinRadius(
+        projected, descriptors, corners, orb_descriptors_, options_.reloc_search_radius_px,
+        options_.reloc_max_hamming, options_.reloc_ratio);
+    if (static_cast<int>(found.size()) >= min_inliers) {
       const std::vector<std::pair<int, int>> seed = std::move(matches);
       matches.clear();
-      for (const auto& [c, dm] : best_of_corner) matches.emplace_back(c, dm.second);
-      std::sort(matches.begin(), matches.end());  // deterministic order
+      for (const auto& [m, c] : found) matches.emplace_back(c, m);
+      std::sort(matches.begin(), matches.end());  // by corner, as the first matches
       append_matches();
       PoseEstimate refined = EstimatePose(*X, *xy, frame.focal_px, est->cam_from_world, pose);
       if (refined.ok && matched_inliers_of(refined) >= matched_inliers) {
@@ -843,8 +811,23 @@ SlamPose SlamSystem::TrackPose(const SlamFrame& frame) {
   bool relocalized = false;
   if (!good && options_.relocalization &&
       (state_ == SlamState::kTracking || state_ == SlamState::kLost)) {
-    relocalized = Relocalize(frame, &map_, options_.reloc_min_inliers, "the map", &X, &xy, &tracks,
-                             &patches, &refound_ids, &refound_uv, &est);
+    if (rejoined && rejoin_placement_ && rejoin_placement_->frame_index == frame.frame_index) {
+      // Placed in the kept map just taken up (its tracks hold none of its points, and
+      // without a pose there was no guided matching: the correspondences are all its).
+      Placement& p = *rejoin_placement_;
+      X = std::move(p.X);
+      xy = std::move(p.xy);
+      tracks = std::move(p.tracks);
+      patches = std::move(p.patches);
+      refound_ids = std::move(p.refound_ids);
+      refound_uv = std::move(p.refound_uv);
+      est = std::move(p.est);
+      rejoin_placement_.reset();
+      relocalized = true;
+    } else {
+      relocalized = Relocalize(frame, &map_, options_.reloc_min_inliers, "the map", &X, &xy,
+                               &tracks, &patches, &refound_ids, &refound_uv, &est);
+    }
     if (relocalized) relocalized_map_ = true;
     good = relocalized;
   }

@@ -897,7 +897,6 @@ class SlamSystem {
     int64_t serial = 0;
     bool metric = false;
     std::optional<Eigen::Vector4d> ground_plane;
-    size_t described = 0;
   };
   std::vector<LostMap> lost_maps_;
   // Relocalize's ORB corners of the last image it saw (image, frame index).
@@ -908,6 +907,18 @@ class SlamSystem {
   int64_t map_serial_ = 0;
   int64_t next_map_serial_ = 1;
   int64_t last_lost_map_search_ = -1;  // image of the last search while tracking
+  // The relocalisation by which a kept map placed an image (Relocalize's outputs), handed
+  // to that image's tracking instead of relocalising it again in the map taken up.
+  struct Placement {
+    int64_t frame_index = -1;
+    std::vector<Eigen::Vector3d> X;
+    std::vector<Eigen::Vector2d> xy;
+    std::vector<int64_t> tracks, refound_ids;
+    std::vector<cv::Mat> patches;
+    std::vector<Eigen::Vector2f> refound_uv;
+    PoseEstimate est;
+  };
+  std::optional<Placement> rejoin_placement_;
   int64_t maps_rejoined_ = 0;
   // Keeps the current map (before it is dropped) among lost_maps_ if it can be
   // relocalised in; the newest beyond lost_maps_kept are dropped, never the oldest.

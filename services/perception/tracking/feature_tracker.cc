@@ -615,33 +615,24 @@ void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat
     orb->detectAndCompute(image, cv::noArray(), kps, desc);
   }
   if (kps.size() < 2) return;
-  const float radius = static_cast<float>(options_.fallback_radius * std::hypot(image.cols, image.rows));
-  // For each lost track (by surviving keypoint), the best and second-best candidates.
-  std::vector<int> best_of(prev_kps.size(), -1);
-  std::vector<int> taken(kps.size(), -1);
-  std::vector<int> best_dist(prev_kps.size(), 256);
-  for (size_t i = 0; i < prev_kps.size(); ++i) {
-    int b1 = 256, b2 = 256, bi = -1;
-    for (size_t j = 0; j < kps.size(); ++j) {
-      const cv::Point2f d = kps[j].pt - prev_kps[i].pt;
-      if (d.dot(d) > radius * radius) continue;
-      const int dist = HammingDistance(prev_desc.ptr<uint8_t>(static_cast<int>(i)),
-                                       desc.ptr<uint8_t>(static_cast<int>(j)), desc.cols);
-      if (dist < b1) {
-        b2 = b1;
-        b1 = dist;
-        bi = static_cast<int>(j);
-      } else if (dist < b2) {
-        b2 = dist;
-      }
+  // Each lost track (by surviving keypoint) matched among the keypoints near it.
+  const auto described = [](const std::vector<cv::KeyPoint>& k, const cv::Mat& d,
+                            std::vector<Eigen::Vector2f>* uv, std::vector<OrbDescriptor>* out) {
+    for (int r = 0; r < d.rows && r < static_cast<int>(k.size()); ++r) {
+      uv->emplace_back(k[static_cast<size_t>(r)].pt.x, k[static_cast<size_t>(r)].pt.y);
+      out->emplace_back();
+      std::memcpy(out->back().bits.data(), d.ptr<uint8_t>(r), out->back().bits.size());
     }
-    if (bi < 0 || b1 > options_.fallback_max_hamming || b1 > options_.fallback_ratio * b2) continue;
-    // Unicity: a keypoint goes to the closest descriptor.
-    if (taken[static_cast<size_t>(bi)] >= 0 && best_dist[static_cast<size_t>(taken[static_cast<size_t>(bi)])] <= b1) continue;
-    if (taken[static_cast<size_t>(bi)] >= 0) best_of[static_cast<size_t>(taken[static_cast<size_t>(bi)])] = -1;
-    taken[static_cast<size_t>(bi)] = static_cast<int>(i);
-    best_of[i] = bi;
-    best_dist[i] = b1;
+  };
+  std::vector<Eigen::Vector2f> prev_uv, uv;
+  std::vector<OrbDescriptor> prev_d, d;
+  described(prev_kps, prev_desc, &prev_uv, &prev_d);
+  described(kps, desc, &uv, &d);
+  std::vector<int> best_of(prev_kps.size(), -1);
+  for (const auto& [i, j] : MatchOrbWithinRadius(
+           prev_uv, prev_d, uv, d, options_.fallback_radius * std::hypot(image.cols, image.rows),
+           options_.fallback_max_hamming, options_.fallback_ratio)) {
+    best_of[static_cast<size_t>(i)] = j;
   }
   // ORB's compute() may drop keypoints: map them back to tracks by position.
   std::vector<Track> still_lost;

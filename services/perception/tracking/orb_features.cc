@@ -1,7 +1,10 @@
 #include "services/perception/tracking/orb_features.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <unordered_map>
 
 #include <opencv2/features2d.hpp>
 
@@ -168,18 +171,20 @@ __attribute__((target_clones("popcnt", "default"))) void NearestTwo(const std::v
 
 }  // namespace
 
-std::vector<std::pair<int, int>> MatchOrb(const std::vector<OrbDescriptor>& query,
-                                          const std::vector<OrbDescriptor>& train, int max_hamming,
-                                          double ratio) {
-  std::vector<Words> q(query.size()), t(train.size());
-  for (size_t i = 0; i < query.size(); ++i) q[i] = WordsOf(query[i]);
-  for (size_t j = 0; j < train.size(); ++j) t[j] = WordsOf(train[j]);
-  std::vector<int> b1(query.size()), bi(query.size()), b2(query.size());
-  NearestTwo(q, t, b1.data(), bi.data(), b2.data());
-  std::vector<int> best_of(query.size(), -1), dist_of(query.size(), 257);
-  std::vector<int> claimed(train.size(), -1);
-  for (size_t i = 0; i < query.size(); ++i) {
-    // An exact tie (the ratio test lets 0 against 0 through) is ambiguous too.
+namespace {
+
+// The matches kept of each query's nearest (b1, at index bi) and second nearest (b2)
+// train descriptor: within max_hamming, strictly nearer than the second (an exact tie,
+// which the ratio test lets through at 0 against 0, is ambiguous too), and passing the
+// ratio test; a train descriptor claimed twice goes to the nearer query (the first on a
+// tie).
+std::vector<std::pair<int, int>> OneToOne(const std::vector<int>& b1, const std::vector<int>& bi,
+                                          const std::vector<int>& b2, size_t train_size,
+                                          int max_hamming, double ratio) {
+  const size_t n = b1.size();
+  std::vector<int> best_of(n, -1), dist_of(n, 257);
+  std::vector<int> claimed(train_size, -1);
+  for (size_t i = 0; i < n; ++i) {
     if (bi[i] < 0 || b1[i] > max_hamming || b1[i] >= b2[i] ||
         static_cast<double>(b1[i]) > ratio * static_cast<double>(b2[i])) {
       continue;
@@ -195,10 +200,75 @@ std::vector<std::pair<int, int>> MatchOrb(const std::vector<OrbDescriptor>& quer
     dist_of[i] = b1[i];
   }
   std::vector<std::pair<int, int>> matches;
-  for (size_t i = 0; i < query.size(); ++i) {
+  for (size_t i = 0; i < n; ++i) {
     if (best_of[i] >= 0) matches.emplace_back(static_cast<int>(i), best_of[i]);
   }
   return matches;
+}
+
+}  // namespace
+
+std::vector<std::pair<int, int>> MatchOrb(const std::vector<OrbDescriptor>& query,
+                                          const std::vector<OrbDescriptor>& train, int max_hamming,
+                                          double ratio) {
+  std::vector<Words> q(query.size()), t(train.size());
+  for (size_t i = 0; i < query.size(); ++i) q[i] = WordsOf(query[i]);
+  for (size_t j = 0; j < train.size(); ++j) t[j] = WordsOf(train[j]);
+  std::vector<int> b1(query.size()), bi(query.size()), b2(query.size());
+  NearestTwo(q, t, b1.data(), bi.data(), b2.data());
+  return OneToOne(b1, bi, b2, train.size(), max_hamming, ratio);
+}
+
+std::vector<std::pair<int, int>> MatchOrbWithinRadius(const std::vector<Eigen::Vector2f>& query_uv,
+                                                      const std::vector<OrbDescriptor>& query,
+                                                      const std::vector<Eigen::Vector2f>& train_uv,
+                                                      const std::vector<OrbDescriptor>& train,
+                                                      double radius_px, int max_hamming,
+                                                      double ratio) {
+  const size_t nq = std::min(query_uv.size(), query.size());
+  const size_t nt = std::min(train_uv.size(), train.size());
+  std::vector<int> b1(nq, 257), bi(nq, -1), b2(nq, 257);
+  if (nq == 0 || nt == 0 || !(radius_px > 0.0) || !std::isfinite(radius_px)) return {};
+  // Train points hashed into cells of the radius: a query looks in its cell's 3 x 3.
+  const double r = radius_px;
+  const auto cell_of = [r](double u, double v) {
+    return std::make_pair(static_cast<int64_t>(std::floor(u / r)),
+                          static_cast<int64_t>(std::floor(v / r)));
+  };
+  struct CellHash {
+    size_t operator()(const std::pair<int64_t, int64_t>& c) const {
+      return std::hash<int64_t>()(c.first * 73856093 ^ c.second * 19349663);
+    }
+  };
+  std::unordered_map<std::pair<int64_t, int64_t>, std::vector<int>, CellHash> grid;
+  for (size_t j = 0; j < nt; ++j) {
+    if (!train_uv[j].allFinite()) continue;
+    grid[cell_of(train_uv[j].x(), train_uv[j].y())].push_back(static_cast<int>(j));
+  }
+  for (size_t i = 0; i < nq; ++i) {
+    if (!query_uv[i].allFinite()) continue;
+    const Eigen::Vector2d uv = query_uv[i].cast<double>();
+    const auto [cu, cv] = cell_of(uv.x(), uv.y());
+    for (int64_t du = -1; du <= 1; ++du) {
+      for (int64_t dv = -1; dv <= 1; ++dv) {
+        const auto g = grid.find({cu + du, cv + dv});
+        if (g == grid.end()) continue;
+        for (const int j : g->second) {
+          if ((train_uv[static_cast<size_t>(j)].cast<double>() - uv).squaredNorm() > r * r)
+            continue;
+          const int d = HammingDistance(query[i], train[static_cast<size_t>(j)]);
+          if (d < b1[i]) {
+            b2[i] = b1[i];
+            b1[i] = d;
+            bi[i] = j;
+          } else if (d < b2[i]) {
+            b2[i] = d;
+          }
+        }
+      }
+    }
+  }
+  return OneToOne(b1, bi, b2, nt, max_hamming, ratio);
 }
 
 }  // namespace mbslam

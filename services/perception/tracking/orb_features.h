@@ -53,6 +53,17 @@ std::vector<std::pair<int, int>> MatchOrb(const std::vector<OrbDescriptor>& quer
                                           const std::vector<OrbDescriptor>& train, int max_hamming,
                                           double ratio);
 
+// One-to-one matches (query index, train index) of queries with a predicted position:
+// the same test as MatchOrb, but each query is compared only with the train points
+// within radius_px of query_uv (a track's last position, a map point's projection).
+// Queries whose position is not finite are skipped. In query order.
+std::vector<std::pair<int, int>> MatchOrbWithinRadius(const std::vector<Eigen::Vector2f>& query_uv,
+                                                      const std::vector<OrbDescriptor>& query,
+                                                      const std::vector<Eigen::Vector2f>& train_uv,
+                                                      const std::vector<OrbDescriptor>& train,
+                                                      double radius_px, int max_hamming,
+                                                      double ratio);
+
 }  // namespace mbslam
 
 #endif  // MBSLAM_SERVICES_PERCEPTION_TRACKING_ORB_FEATURES_H_

@@ -50,6 +50,49 @@ TEST(OrbFeatures, MatchOrbIsOneToOneWithTheRatioTest) {
   EXPECT_TRUE(MatchOrb(query, {}, 50, 0.8).empty());
 }
 
+TEST(OrbFeatures, MatchOrbWithinRadiusComparesOnlyTheTrainPointsNearEachQuery) {
+  const OrbDescriptor a = Bits({0, 1, 2, 3, 4, 5, 6, 7, 8, 9});
+  const OrbDescriptor b = Bits({100, 101, 102, 103, 104, 105});
+  using V = Eigen::Vector2f;
+  // Train: a at (100, 100), a copy of a far away at (400, 100), b at (110, 100).
+  const std::vector<V> train_uv = {V(100, 100), V(400, 100), V(110, 100)};
+  const std::vector<OrbDescriptor> train = {a, a, b};
+  // A query like a near (100, 100): the far copy is outside the radius, so it is not
+  // ambiguous (global matching finds it ambiguous).
+  const OrbDescriptor qa = Bits({0, 1, 2, 3, 4, 5, 6, 7, 8});
+  EXPECT_EQ(MatchOrbWithinRadius({V(104, 100)}, {qa}, train_uv, train, 20.0, 50, 0.8),
+            (std::vector<std::pair<int, int>>{{0, 0}}));
+  EXPECT_TRUE(MatchOrb({qa}, train, 50, 0.8).empty());
+  // Near the far copy, the query takes it.
+  EXPECT_EQ(MatchOrbWithinRadius({V(390, 95)}, {qa}, train_uv, train, 20.0, 50, 0.8),
+            (std::vector<std::pair<int, int>>{{0, 1}}));
+  // Beyond the radius of every train point: no match (the radius is a Euclidean one:
+  // (85, 115) is 21.2 px from (100, 100), in a neighbouring cell).
+  EXPECT_TRUE(MatchOrbWithinRadius({V(250, 100)}, {qa}, train_uv, train, 20.0, 50, 0.8).empty());
+  EXPECT_TRUE(MatchOrbWithinRadius({V(85, 115)}, {qa}, train_uv, train, 20.0, 50, 0.8).empty());
+  // The ratio test among the points in the radius: 5 bits against 6 fails at 0.8.
+  const std::vector<V> two_uv = {V(100, 100), V(105, 100)};
+  const std::vector<OrbDescriptor> two = {
+      Bits({0, 1, 2, 3, 4, 5, 6, 7, 8, 20, 21, 22, 23, 24}),
+      Bits({0, 1, 2, 3, 4, 5, 6, 7, 8, 30, 31, 32, 33, 34, 35})};
+  EXPECT_TRUE(MatchOrbWithinRadius({V(102, 100)}, {qa}, two_uv, two, 20.0, 50, 0.8).empty());
+  EXPECT_EQ(MatchOrbWithinRadius({V(102, 100)}, {qa}, two_uv, two, 20.0, 50, 1.0).size(), 1u);
+  // One to one: two queries on the same train point, the nearer in bits keeps it,
+  // whichever comes first.
+  const OrbDescriptor qa_far = Bits({0, 1, 2, 3, 4, 5, 6});
+  EXPECT_EQ(MatchOrbWithinRadius({V(100, 100), V(101, 100)}, {qa_far, qa}, train_uv, train, 20.0,
+                                 50, 0.8),
+            (std::vector<std::pair<int, int>>{{1, 0}}));
+  EXPECT_EQ(MatchOrbWithinRadius({V(100, 100), V(101, 100)}, {qa, qa_far}, train_uv, train, 20.0,
+                                 50, 0.8),
+            (std::vector<std::pair<int, int>>{{0, 0}}));
+  // The distance limit, a query without a position, and degenerate radii.
+  EXPECT_TRUE(MatchOrbWithinRadius({V(104, 100)}, {qa}, train_uv, train, 20.0, 0, 0.8).empty());
+  EXPECT_TRUE(MatchOrbWithinRadius({V(NAN, 100)}, {qa}, train_uv, train, 20.0, 50, 0.8).empty());
+  EXPECT_TRUE(MatchOrbWithinRadius({V(104, 100)}, {qa}, train_uv, train, 0.0, 50, 0.8).empty());
+  EXPECT_TRUE(MatchOrbWithinRadius({V(104, 100)}, {qa}, {}, {}, 20.0, 50, 0.8).empty());
+}
+
 TEST(OrbFeatures, GivenPointsAreDescribedAsDetectedOnes) {
   const cv::Mat image = testing_images::Texture(320, 240, 7);
   std::vector<Eigen::Vector2f> corners;
