@@ -337,11 +337,16 @@ TEST(SlamRelocalization, ATrackingMapGivesWayToAnOlderKeptMap) {
     if (c == kLongInterval) options.lost_map_search_frames = 50;
     const int window = 11;  // images at the place: a search every 10 finds it
     SlamSystem slam(options);
+    // The loaded map's ground plane goes with it, and comes back with it.
+    const Eigen::Vector4d loaded_ground(0.0, -1.0, 0.0, 1.5), new_ground(0.0, -0.8, 0.6, 0.7);
+    slam.SetGroundPlane(loaded_ground);
     int64_t f = 0;
     for (; f < 60 && slam.state() != SlamState::kTracking; ++f) {
       slam.TrackPose(sliding.Frame(f, other, K));
     }
     ASSERT_EQ(slam.state(), SlamState::kTracking) << "the new map was made";
+    EXPECT_FALSE(slam.ground_plane().has_value());
+    slam.SetGroundPlane(new_ground);
     slam.TrackPose(sliding.Frame(f++, other, K));  // the first search: nothing there
     EXPECT_EQ(slam.maps_rejoined(), 0);
     // The camera reaches the loaded map's place (its tracks go on in the new map).
@@ -364,6 +369,8 @@ TEST(SlamRelocalization, ATrackingMapGivesWayToAnOlderKeptMap) {
         << "in the loaded map's frame";
     EXPECT_GT(slam.map().num_points(), 150u);
     EXPECT_EQ(slam.lost_maps(), 1u) << "the new map is kept in turn";
+    ASSERT_TRUE(slam.ground_plane().has_value());
+    EXPECT_EQ(*slam.ground_plane(), loaded_ground);
     // It is not searched again: only older maps replace the current one.
     for (int64_t end = f + 2 * options.lost_map_search_frames; f < end; ++f) {
       slam.TrackPose(sliding.Frame(f, Render(scene.texture, scene.plane, Rigid3d()), K));

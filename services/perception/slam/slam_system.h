@@ -635,6 +635,7 @@ class SlamSystem {
   // other units), rescaled with it. A plane with a normal that is not a unit vector is
   // ignored.
   void SetGroundPlane(const Eigen::Vector4d& plane);
+  const std::optional<Eigen::Vector4d>& ground_plane() const { return ground_plane_; }
 
   // The current estimate of a recent image's pose (follows bundle adjustment).
   std::optional<Rigid3d> PoseOfFrame(int64_t frame) const { return PoseOf(frame); }
