@@ -40,6 +40,8 @@ std::unique_ptr<PerceptionService> PerceptionService::Create(const PerceptionOpt
   if (!s->adapter_) return nullptr;
   PerceptionService* self = s.get();
   s->adapter_->set_snapshot_callback([self](const std::string& prefix, int what) {
+    if (what & mbslam::snapshot_request_t::WHAT_GLOBAL_BA)
+      self->core_->RequestGlobalBundleAdjustment();
     if ((what & mbslam::snapshot_request_t::WHAT_OUTPUTS) == 0) return;
     const std::string& output_dir = self->options_.service.output_dir;
     if (prefix.empty()) {

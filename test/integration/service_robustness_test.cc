@@ -197,5 +197,27 @@ TEST(ServiceSnapshotRequests, PathsOutsideTheOutputDirAreRefused) {
   std::filesystem::remove_all(root);
 }
 
+// WHAT_GLOBAL_BA asks the service's SLAM for a bundle adjustment of its whole map: it is
+// counted when an image takes it up. The images here make no map, so it does not start
+// (SlamGlobalBundleAdjustment tests that it does on a map).
+TEST_F(ServiceRobustness, AGlobalBundleAdjustmentRequestIsCounted) {
+  const ChannelOptions ch;
+  int64_t t = 1000000;
+  Send(ch.camera_image, mbslam::EncodeLcmMessage(Image(t, 0)));
+  mbslam::snapshot_request_t r{};
+  r.utime = t;
+  r.path_prefix = "global_ba";
+  r.what = mbslam::snapshot_request_t::WHAT_GLOBAL_BA;
+  Send(ch.snapshot_request, mbslam::EncodeLcmMessage(r));
+  for (int i = 1; i < 4; ++i) Send(ch.camera_image, mbslam::EncodeLcmMessage(Image(t += 33333, i)));
+  std::map<std::string, int64_t> c = FinalCounters();
+  EXPECT_EQ(c["slam_global_ba_requested"], 1);
+  EXPECT_EQ(c["slam_global_ba_started"], 0) << "no map to adjust";
+  EXPECT_EQ(poses_, 4);
+  EXPECT_EQ(c["snapshot_request_decode_error"], 0);
+  ASSERT_FALSE(statuses_.empty());
+  EXPECT_NE(statuses_.back().state, mbslam::status_t::STATE_DEGRADED) << "a request is no fault";
+}
+
 }  // namespace
 }  // namespace mbslam

@@ -482,6 +482,10 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   }
   ++frame_index_;
   frame_utime_[frame_index_] = frame.utime;
+  if (global_ba_request_.exchange(false)) {
+    counters_->Increment(counter::kGlobalBaRequested);
+    slam_.RequestGlobalBundleAdjustment();
+  }
   // As far back as the odometry motions of the segmentation reach, and as the poses SLAM
   // may back-fill (their times are looked up here).
   const size_t keep_utimes = 64 + static_cast<size_t>(std::max(0, options_.slam.backfill_max_frames));
@@ -700,6 +704,11 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   if (slam_.ba_runs() != ba_runs_seen_) {
     ba_runs_seen_ = slam_.ba_runs();
     ba_timer_->Add(slam_.last_ba_seconds() * 1e3);
+  }
+  if (slam_.requested_ba_runs() != requested_ba_runs_seen_) {
+    counters_->Increment(counter::kGlobalBaStarted,
+                         slam_.requested_ba_runs() - requested_ba_runs_seen_);
+    requested_ba_runs_seen_ = slam_.requested_ba_runs();
   }
   if (map_update.culled_points > 0) counters_->Increment(counter::kMapPointsCulled, map_update.culled_points);
   // The metric rescale comes with a new keyframe: the plane is rescaled first, so that a

@@ -6,6 +6,7 @@
 // the pipeline's processing thread; knows nothing of LCM.
 
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <future>
 #include <map>
@@ -126,6 +127,10 @@ class PerceptionCore : public FrameProcessor {
 
   const PoseBuffer& odometry() const { return odometry_; }
   const SlamSystem& slam() const { return slam_; }
+  // Asks for a global bundle adjustment of the static map, taken up by the next image
+  // (SlamSystem::RequestGlobalBundleAdjustment). Thread-safe: the LCM thread calls it on
+  // a SNAPSHOT_REQUEST with WHAT_GLOBAL_BA.
+  void RequestGlobalBundleAdjustment() { global_ba_request_.store(true); }
   size_t num_object_records() const { return object_records_.size(); }
   void Finish() override {
     slam_.Flush();
@@ -218,6 +223,8 @@ class PerceptionCore : public FrameProcessor {
   std::future<std::vector<std::pair<int, bool>>> person_job_;
   int64_t frame_index_ = -1;
   int64_t ba_runs_seen_ = 0;
+  std::atomic<bool> global_ba_request_{false};
+  int64_t requested_ba_runs_seen_ = 0;
 };
 
 }  // namespace mbslam

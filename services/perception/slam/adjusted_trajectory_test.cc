@@ -397,5 +397,61 @@ TEST(SlamAdjustedTrajectory, ObjectMapsKeepNone) {
   EXPECT_EQ(s.adjusted_trajectory_max_poses, 0);
 }
 
+// A global bundle adjustment asked for (SlamSystem::RequestGlobalBundleAdjustment)
+// adjusts the whole map at the next image: keyframes older than the local window, which
+// local adjustments hold fixed, move, and the keyframe trajectory is no worse for it.
+TEST(SlamGlobalBundleAdjustment, OnRequestTheWholeMapIsAdjusted) {
+  const Scene scene(5);
+  SlamOptions options = Deterministic();
+  options.ba.global_max_keyframes = 2;  // only local adjustments of their own accord
+  for (const bool request : {false, true}) {
+    SCOPED_TRACE(request);
+    SlamSystem slam(options);
+    const auto step = [&](int f) {
+      const SlamFrame frame = scene.Frame(f);
+      slam.TrackPose(frame);
+      std::unordered_map<int64_t, int> labels;
+      for (const SlamObservation& o : frame.observations) labels[o.track_id] = o.body_id;
+      slam.UpdateMap(frame, labels);
+    };
+    for (int f = 0; f < kImages - 1; ++f) step(f);
+    slam.Flush();
+    ASSERT_GT(static_cast<int>(slam.map().num_keyframes()), options.ba.window_keyframes + 4);
+    const auto keyframe_poses = [&]() {
+      std::map<int64_t, Rigid3d> by_utime;
+      for (const auto& [id, k] : slam.map().keyframes()) by_utime[k.utime] = k.cam_from_world;
+      return by_utime;
+    };
+    const std::map<int64_t, Rigid3d> before = keyframe_poses();
+    // Older than the newest window (and one more, should the last image make a keyframe).
+    std::set<int64_t> old;
+    for (auto it = before.begin();
+         std::distance(it, before.end()) > options.ba.window_keyframes + 1; ++it)
+      old.insert(it->first);
+    if (request) {
+      slam.RequestGlobalBundleAdjustment();
+      slam.RequestGlobalBundleAdjustment();  // asked twice before it starts: once
+      EXPECT_TRUE(slam.global_ba_pending());
+    }
+    step(kImages - 1);
+    slam.Flush();
+    EXPECT_FALSE(slam.global_ba_pending());
+    EXPECT_EQ(slam.requested_ba_runs(), request ? 1 : 0);
+    const std::map<int64_t, Rigid3d> after = keyframe_poses();
+    double moved = 0.0;
+    for (const int64_t u : old) {
+      auto a = after.find(u);
+      if (a != after.end()) moved = std::max(moved, TranslationGap(a->second, before.at(u)));
+    }
+    if (!request) {
+      EXPECT_EQ(moved, 0.0) << "local adjustments hold the old keyframes";
+      continue;
+    }
+    EXPECT_GT(moved, 1e-5) << "the whole map was adjusted";
+    EXPECT_LE(AlignedRms(after, /*with_scale=*/true),
+              1.01 * AlignedRms(before, /*with_scale=*/true));
+  }
+}
+
 }  // namespace
 }  // namespace mbslam

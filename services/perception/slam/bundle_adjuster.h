@@ -32,6 +32,10 @@ struct BundleAdjustmentOptions {
   double huber_px = 2.0;         // Huber threshold (px)
   double outlier_px = 4.0;       // observations above this after the BA are removed (px)
   int global_max_keyframes = 40; // a map up to this size gets a global BA after initialisation (count)
+  // A global BA asked for (SlamSystem::RequestGlobalBundleAdjustment) runs in the back-end
+  // over the whole map, however large, with these bounds instead.
+  int requested_max_iterations = 50;   // solver iterations (count)
+  double requested_max_seconds = 5.0;  // solver time limit (s)
   double odometry_sigma_per_m = 0.02;  // odometry translation prior: noise per metre (m/m)
   double odometry_sigma_floor_m = 0.005;  // ... plus this floor (m)
 
@@ -42,6 +46,8 @@ struct BundleAdjustmentOptions {
     MBSLAM_CHECK_OPTION_GT(huber_px, 0.0);
     MBSLAM_CHECK_OPTION_GT(outlier_px, 0.0);
     MBSLAM_CHECK_OPTION_GE(global_max_keyframes, 2);
+    MBSLAM_CHECK_OPTION_GT(requested_max_iterations, 0);
+    MBSLAM_CHECK_OPTION_GT(requested_max_seconds, 0.0);
     MBSLAM_CHECK_OPTION_GT(odometry_sigma_per_m, 0.0);
     MBSLAM_CHECK_OPTION_GT(odometry_sigma_floor_m, 0.0);
     return true;
@@ -55,6 +61,10 @@ struct BundleAdjustmentOptions {
     v("huber_px", &huber_px, "Huber threshold (px)");
     v("outlier_px", &outlier_px, "observations above this after BA are removed (px)");
     v("global_max_keyframes", &global_max_keyframes, "maps up to this size get a global BA (count)");
+    v("requested_max_iterations", &requested_max_iterations,
+      "solver iterations of a global BA asked for (SNAPSHOT_REQUEST WHAT_GLOBAL_BA) (count)");
+    v("requested_max_seconds", &requested_max_seconds,
+      "solver time limit of a global BA asked for (s)");
     v("odometry_sigma_per_m", &odometry_sigma_per_m, "odometry prior noise per metre (m/m)");
     v("odometry_sigma_floor_m", &odometry_sigma_floor_m, "odometry prior noise floor (m)");
   }

@@ -1970,6 +1970,14 @@ SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered
     update.rescaled_by = EstablishMetricScale();
     StartBundleAdjustment(static_cast<int>(map_.num_keyframes()) <= options_.ba.global_max_keyframes);
   }
+  if (global_ba_requested_ && map_.num_keyframes() >= 2 && !ba_running_) {
+    global_ba_requested_ = false;
+    ++requested_ba_runs_;
+    MBSLAM_LOG(INFO) << log_name_ << " frame " << frame.frame_index
+                     << ": global bundle adjustment asked for (" << map_.num_keyframes()
+                     << " keyframes, " << map_.num_points() << " points)";
+    StartBundleAdjustment(/*global=*/true, /*requested=*/true);
+  }
   return update;
 }
 
@@ -2004,10 +2012,16 @@ std::optional<PoseRotationPrior> SlamSystem::TrackingRotationPrior(const SlamFra
   return std::nullopt;
 }
 
-void SlamSystem::StartBundleAdjustment(bool global) {
+void SlamSystem::StartBundleAdjustment(bool global, bool requested) {
+  BundleAdjustmentOptions ba = options_.ba;
+  if (requested) {
+    global = true;
+    ba.max_iterations = ba.requested_max_iterations;
+    ba.max_seconds = ba.requested_max_seconds;
+  }
   if (!options_.background_ba) {
     BaProblem problem = ExtractBa(options_.ba.window_keyframes, global, focal_px_, metric_ && options_.use_odometry);
-    const BaSummary s = SolveBa(&problem, options_.ba);
+    const BaSummary s = SolveBa(&problem, ba);
     ++ba_runs_;
     last_ba_seconds_ = s.seconds;
     if (s.usable) {
@@ -2021,12 +2035,13 @@ void SlamSystem::StartBundleAdjustment(bool global) {
   ba_problem_ = std::make_unique<BaProblem>(
       ExtractBa(options_.ba.window_keyframes, global, focal_px_, metric_ && options_.use_odometry));
   ba_running_ = true;
-  ba_thread_ = std::thread([this] {
+  ba_thread_ = std::thread([this, ba] {
     // Lower priority than the per-image loop: on a 2-core robot computer the BA must not
     // delay images (its result is merged whenever it is ready). Raising niceness is
     // always permitted; a failure only leaves the default priority.
-    if (options_.background_ba_nice > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), options_.background_ba_nice);
-    ba_summary_ = SolveBa(ba_problem_.get(), options_.ba);
+    if (options_.background_ba_nice > 0)
+      setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), options_.background_ba_nice);
+    ba_summary_ = SolveBa(ba_problem_.get(), ba);
     ba_running_ = false;
   });
 }

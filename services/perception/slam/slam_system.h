@@ -651,6 +651,17 @@ class SlamSystem {
   // once, with its latest pose. Call Flush() first for the last adjustment to count.
   std::vector<std::pair<int64_t, Rigid3d>> AdjustedTrajectory() const;
 
+  // Asks for a bundle adjustment of the whole static map (every keyframe and point; the
+  // map's first keyframe stays fixed), as an operator may before saving it or after a
+  // long run: it starts in the back-end at the next image that updates a tracking map
+  // with at least two keyframes and no adjustment running, and is merged like a local
+  // one (used only if the solver's summary says so). Asking again before it starts asks
+  // once. Not thread-safe: call it from the thread that runs the SLAM.
+  void RequestGlobalBundleAdjustment() { global_ba_requested_ = true; }
+  bool global_ba_pending() const { return global_ba_requested_; }
+  // Global BAs run on request so far.
+  int64_t requested_ba_runs() const { return requested_ba_runs_; }
+
   // Waits for the back-end, e.g. before reading the map or at the end of a replay.
   void Flush();
   void Reset();
@@ -750,7 +761,9 @@ class SlamSystem {
   void AddKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels,
                    SlamMapUpdate* update);
   bool NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const;
-  void StartBundleAdjustment(bool global);
+  // A local BA (global: over the whole map when it is small), or the global BA asked for
+  // (requested: the whole map, with the requested_* solver bounds).
+  void StartBundleAdjustment(bool global, bool requested = false);
   // ExtractBaProblem with this SLAM's rotation prior settings.
   BaProblem ExtractBa(int window, bool global, double focal_px, bool use_odometry) const;
   // The rotation prior of `frame` against the last keyframe with one of the same
@@ -963,6 +976,8 @@ class SlamSystem {
   std::unique_ptr<BaProblem> ba_problem_;
   BaSummary ba_summary_;
   int64_t ba_runs_ = 0;
+  bool global_ba_requested_ = false;
+  int64_t requested_ba_runs_ = 0;
   double last_ba_seconds_ = 0.0;
 };
 
