@@ -194,6 +194,9 @@ TEST(ServiceSnapshotRequests, PathsOutsideTheOutputDirAreRefused) {
     if (c.name == "snapshot_request_refused_path") refused = c.value;
   }
   EXPECT_EQ(refused, 2);
+  for (const auto& c : statuses.back().counters) {
+    EXPECT_NE(c.name, "slam_global_ba_requested") << "WHAT_OUTPUTS asks for no adjustment";
+  }
   std::filesystem::remove_all(root);
 }
 

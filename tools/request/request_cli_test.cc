@@ -64,6 +64,13 @@ TEST(RequestCli, SendsWhatIsAskedFor) {
   ASSERT_EQ(Request("--view-image", &sent), 0);
   ASSERT_EQ(sent.size(), 1u);
   EXPECT_EQ(sent[0].what, mbslam::snapshot_request_t::WHAT_VIEW_IMAGE);
+  ASSERT_EQ(Request("--view-3d", &sent), 0);
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_EQ(sent[0].what, mbslam::snapshot_request_t::WHAT_VIEW_3D);
+  std::string out;
+  EXPECT_EQ(testing_util::RunCommand(testing_util::ToolPath("mbslam-request") + " --help", &out),
+            0);
+  EXPECT_NE(out.find("--global-ba"), std::string::npos);
 }
 
 TEST(RequestCli, RefusesAnEmptyOrUnknownRequest) {
@@ -74,7 +81,13 @@ TEST(RequestCli, RefusesAnEmptyOrUnknownRequest) {
   EXPECT_TRUE(sent.empty());
   EXPECT_EQ(Request("--outputs run1", &sent), 2) << "a flag with a value";
   EXPECT_TRUE(sent.empty());
+  EXPECT_EQ(Request("--global-ba x", &sent), 2);
+  EXPECT_TRUE(sent.empty());
+  EXPECT_EQ(Request("--outputs run1 --outputs", &sent), 2) << "a value on either";
+  EXPECT_TRUE(sent.empty());
   EXPECT_EQ(Request("--global-ba --channel ''", &sent), 2);
+  EXPECT_TRUE(sent.empty());
+  EXPECT_EQ(Request("--outputs --prefix", &sent), 2) << "an option without its value";
   EXPECT_TRUE(sent.empty());
   std::string out;
   EXPECT_EQ(testing_util::RunCommand(testing_util::ToolPath("mbslam-request") +

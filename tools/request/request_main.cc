@@ -33,6 +33,8 @@ constexpr char kUsage[] =
     "                back end, started at the next image; counted as slam_global_ba_started)\n"
     "  --outputs     the service writes trajectories, map PLY, occupancy .bt and summary now\n"
     "  --views       the viewer renders both PNG views now (--view-3d, --view-image: one)\n"
+    "Sent is not received: LCM does not acknowledge. --global-ba with --outputs writes the\n"
+    "outputs before the adjustment has run.\n"
     "exit status: 0 sent, 2 bad command line or bus error\n";
 
 int Run(int argc, char** argv) {
@@ -41,11 +43,18 @@ int Run(int argc, char** argv) {
     std::fputs(kUsage, stdout);
     return 0;
   }
-  // The flags take no value ('--outputs run1' is a mistake for '--outputs --prefix run1').
+  // The flags take no value ('--outputs run1' is a mistake for '--outputs --prefix run1'),
+  // the options one.
   std::string flag_with_value;
   for (const char* flag : {"global-ba", "outputs", "views", "view-3d", "view-image"}) {
-    if (args.Has(flag) && !args.Get(flag).empty() && flag_with_value.empty())
-      flag_with_value = std::string("--") + flag + " takes no value";
+    for (const std::string& v : args.GetAll(flag)) {
+      if (!v.empty() && flag_with_value.empty())
+        flag_with_value = std::string("--") + flag + " takes no value";
+    }
+  }
+  for (const char* option : {"lcm-url", "channel", "prefix"}) {
+    if (args.Has(option) && args.Get(option).empty() && flag_with_value.empty())
+      flag_with_value = std::string("--") + option + " needs a value";
   }
   int what = 0;
   if (args.Has("global-ba")) what |= mbslam::snapshot_request_t::WHAT_GLOBAL_BA;
@@ -57,11 +66,10 @@ int Run(int argc, char** argv) {
   const std::string channel = args.Get("channel", mbslam::ChannelOptions().snapshot_request);
   const std::string prefix = args.Get("prefix");
   const std::string problems = args.Problems();
-  if (!problems.empty() || !flag_with_value.empty() || what == 0 || channel.empty()) {
+  if (!problems.empty() || !flag_with_value.empty() || what == 0) {
     const std::string why = !problems.empty()          ? problems
                             : !flag_with_value.empty() ? flag_with_value
-                            : what == 0                ? "nothing asked for"
-                                                       : "empty channel";
+                                                       : "nothing asked for";
     std::fprintf(stderr, "mbslam-request: %s\n%s", why.c_str(), kUsage);
     return 2;
   }

@@ -78,7 +78,7 @@ inline constexpr const char* kMapPointsCulled = "map_points_culled";            
 inline constexpr const char* kObjectRecordsPruned = "object_records_pruned";    // per-object state of objects gone
 inline constexpr const char* kOccupancyCrops = "occupancy_crops";                // memory bound: cropped around the camera
 inline constexpr const char* kOccupancyVoxelsDropped = "occupancy_voxels_dropped";  // occupied voxels those crops dropped
-inline constexpr const char* kGlobalBaRequested = "slam_global_ba_requested";  // SNAPSHOT_REQUEST WHAT_GLOBAL_BA received
+inline constexpr const char* kGlobalBaRequested = "slam_global_ba_requested";  // images that took SNAPSHOT_REQUEST WHAT_GLOBAL_BA (requests between two images: once)
 inline constexpr const char* kGlobalBaStarted = "slam_global_ba_started";      // ... and its whole-map adjustment started
 }  // namespace counter
 

@@ -31,6 +31,7 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
       objects_timer_(timers->Get("objects")),
       person_timer_(timers->Get("person")),
       ba_timer_(timers->Get("local_ba")),
+      global_ba_timer_(timers->Get("global_ba")),
       outputs_timer_(timers->Get("outputs")),
       odometry_(options.preprocess.max_odometry_gap_us,
                 static_cast<size_t>(options.preprocess.max_odometry_samples)),
@@ -39,7 +40,8 @@ PerceptionCore::PerceptionCore(const CoreOptions& options, Counters* counters, S
       person_detector_(options.person),
       slam_(options.slam),
       object_tracking_(options.objects),
-      object_reconstruction_(std::make_unique<ObjectReconstruction>(options.object_slam, options.slam)),
+      object_reconstruction_(
+          std::make_unique<ObjectReconstruction>(options.object_slam, options.slam)),
       object_slam_timer_(timers->Get("object_slam")),
       warp_timer_(timers->Get("warp_alignment")) {
   const auto& q = options.odometry.base_from_cam_rotation;
@@ -703,7 +705,7 @@ FrameResult PerceptionCore::ProcessFrame(const ImageFrame& frame) {
   // slam.background_ba, so not part of this image's time), recorded when a run is merged.
   if (slam_.ba_runs() != ba_runs_seen_) {
     ba_runs_seen_ = slam_.ba_runs();
-    ba_timer_->Add(slam_.last_ba_seconds() * 1e3);
+    (slam_.last_ba_requested() ? global_ba_timer_ : ba_timer_)->Add(slam_.last_ba_seconds() * 1e3);
   }
   if (slam_.requested_ba_runs() != requested_ba_runs_seen_) {
     counters_->Increment(counter::kGlobalBaStarted,

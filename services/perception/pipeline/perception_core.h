@@ -182,6 +182,7 @@ class PerceptionCore : public FrameProcessor {
   TimingStats* objects_timer_;
   TimingStats* person_timer_;   // person checks (part of no other stage)
   TimingStats* ba_timer_;       // bundle adjustment runs (solver time, back-end thread)
+  TimingStats* global_ba_timer_;  // global bundle adjustments asked for (solver time)
   TimingStats* outputs_timer_;  // map / track messages built for the sinks
   PoseBuffer odometry_;
   Rigid3d base_from_cam_;

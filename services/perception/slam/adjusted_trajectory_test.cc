@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/testing/temp_dir.h"
 #include "services/perception/slam/object_reconstruction.h"
 #include "services/perception/slam/slam_system.h"
 
@@ -450,6 +451,49 @@ TEST(SlamGlobalBundleAdjustment, OnRequestTheWholeMapIsAdjusted) {
     EXPECT_GT(moved, 1e-5) << "the whole map was adjusted";
     EXPECT_LE(AlignedRms(after, /*with_scale=*/true),
               1.01 * AlignedRms(before, /*with_scale=*/true));
+  }
+}
+
+// The map saved at exit is first adjusted as a whole (slam.map_save_global_ba): its
+// keyframes beyond the local window differ from the map's before the save; without the
+// option the file holds the map as it was.
+TEST(SlamGlobalBundleAdjustment, TheSavedMapIsAdjustedAsAWhole) {
+  const Scene scene(5);
+  const std::string dir = testing_util::MakeTestTempDir("global_ba_save");
+  for (const bool adjust : {false, true}) {
+    SCOPED_TRACE(adjust);
+    SlamOptions options = Deterministic();
+    options.ba.global_max_keyframes = 2;
+    options.map_save_global_ba = adjust;
+    options.map_save_path = dir + (adjust ? "/adjusted.map" : "/plain.map");
+    std::map<int64_t, Rigid3d> before;
+    {
+      SlamSystem slam(options);
+      for (int f = 0; f < kImages; ++f) {
+        const SlamFrame frame = scene.Frame(f);
+        slam.TrackPose(frame);
+        std::unordered_map<int64_t, int> labels;
+        for (const SlamObservation& o : frame.observations) labels[o.track_id] = o.body_id;
+        slam.UpdateMap(frame, labels);
+      }
+      slam.Flush();
+      for (const auto& [id, k] : slam.map().keyframes()) before[k.utime] = k.cam_from_world;
+    }  // saved here
+    Map saved;
+    ASSERT_TRUE(saved.Load(options.map_save_path).ok());
+    ASSERT_EQ(saved.num_keyframes(), before.size());
+    double moved = 0.0;
+    int n = 0;
+    for (const auto& [id, k] : saved.keyframes()) {
+      if (++n > static_cast<int>(before.size()) - options.ba.window_keyframes)
+        break;  // the old ones
+      moved = std::max(moved, TranslationGap(k.cam_from_world, before.at(k.utime)));
+    }
+    if (adjust) {
+      EXPECT_GT(moved, 1e-5);
+    } else {
+      EXPECT_LT(moved, 1e-9);
+    }
   }
 }
 

@@ -276,6 +276,13 @@ Status SlamSystem::SaveMap(const std::string& path) {
     if (lost.map.num_keyframes() > largest->num_keyframes()) largest = &lost.map;
   }
   if (largest->num_keyframes() == 0) return Status::Error("no map to save");
+  if (largest == &map_ && options_.map_save_global_ba && map_.num_keyframes() >= 2) {
+    const int64_t runs = ba_runs_;
+    StartBundleAdjustment(/*global=*/true, /*requested=*/true, /*here_and_now=*/true);
+    MBSLAM_LOG(INFO) << log_name_ << ": the map saved was first adjusted as a whole ("
+                     << map_.num_keyframes() << " keyframes, " << last_ba_seconds_ << " s, "
+                     << (ba_runs_ > runs && last_ba_usable_ ? "used" : "not used") << ")";
+  }
   if (largest != &map_) {
     MBSLAM_LOG(INFO) << log_name_ << ": the map saved is a kept one (" << largest->num_keyframes()
                      << " keyframes; the current map has " << map_.num_keyframes() << ")";
@@ -1965,18 +1972,24 @@ SlamMapUpdate SlamSystem::UpdateMap(const SlamFrame& frame, const std::unordered
   }
   if (state_ != SlamState::kTracking && state_ != SlamState::kConfirming) return update;
   if (!cur) return update;
-  if (NeedKeyframe(frame, labels)) {
+  const bool keyframe = NeedKeyframe(frame, labels);
+  if (keyframe) {
     AddKeyframe(frame, labels, &update);
     update.rescaled_by = EstablishMetricScale();
-    StartBundleAdjustment(static_cast<int>(map_.num_keyframes()) <= options_.ba.global_max_keyframes);
   }
-  if (global_ba_requested_ && map_.num_keyframes() >= 2 && !ba_running_) {
+  // A global adjustment asked for starts before (instead of) a keyframe's local one, which
+  // it covers: else, live, a local one started at every keyframe could put it off.
+  if (global_ba_requested_ && state_ == SlamState::kTracking && map_.num_keyframes() >= 2 &&
+      !ba_running_) {
     global_ba_requested_ = false;
     ++requested_ba_runs_;
     MBSLAM_LOG(INFO) << log_name_ << " frame " << frame.frame_index
                      << ": global bundle adjustment asked for (" << map_.num_keyframes()
                      << " keyframes, " << map_.num_points() << " points)";
     StartBundleAdjustment(/*global=*/true, /*requested=*/true);
+  } else if (keyframe) {
+    StartBundleAdjustment(static_cast<int>(map_.num_keyframes()) <=
+                          options_.ba.global_max_keyframes);
   }
   return update;
 }
@@ -2012,18 +2025,21 @@ std::optional<PoseRotationPrior> SlamSystem::TrackingRotationPrior(const SlamFra
   return std::nullopt;
 }
 
-void SlamSystem::StartBundleAdjustment(bool global, bool requested) {
+void SlamSystem::StartBundleAdjustment(bool global, bool requested, bool here_and_now) {
   BundleAdjustmentOptions ba = options_.ba;
   if (requested) {
     global = true;
     ba.max_iterations = ba.requested_max_iterations;
     ba.max_seconds = ba.requested_max_seconds;
   }
-  if (!options_.background_ba) {
+  if (!options_.background_ba || here_and_now) {
+    MergeBundleAdjustment(/*wait=*/true);
     BaProblem problem = ExtractBa(options_.ba.window_keyframes, global, focal_px_, metric_ && options_.use_odometry);
     const BaSummary s = SolveBa(&problem, ba);
     ++ba_runs_;
     last_ba_seconds_ = s.seconds;
+    last_ba_usable_ = s.usable;
+    last_ba_requested_ = requested;
     if (s.usable) {
       ApplyBaResult(problem, options_.ba, &map_);
       RefineTrajectory();
@@ -2035,6 +2051,7 @@ void SlamSystem::StartBundleAdjustment(bool global, bool requested) {
   ba_problem_ = std::make_unique<BaProblem>(
       ExtractBa(options_.ba.window_keyframes, global, focal_px_, metric_ && options_.use_odometry));
   ba_running_ = true;
+  running_ba_requested_ = requested;
   ba_thread_ = std::thread([this, ba] {
     // Lower priority than the per-image loop: on a 2-core robot computer the BA must not
     // delay images (its result is merged whenever it is ready). Raising niceness is
@@ -2052,6 +2069,8 @@ void SlamSystem::MergeBundleAdjustment(bool wait) {
   ba_thread_.join();
   ++ba_runs_;
   last_ba_seconds_ = ba_summary_.seconds;
+  last_ba_usable_ = ba_summary_.usable;
+  last_ba_requested_ = running_ba_requested_;
   if (ba_summary_.usable && ba_problem_) {
     ApplyBaResult(*ba_problem_, options_.ba, &map_);
     RefineTrajectory();

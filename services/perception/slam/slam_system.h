@@ -18,6 +18,7 @@
 // trusted; failures retry automatically. With odometry the map is metric.
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -248,6 +249,10 @@ struct SlamOptions {
   bool adjusted_trajectory_skip_released = true;
   std::string map_load_path;             // map loaded at start ("" = none)
   std::string map_save_path;             // map saved at exit ("" = none)
+  // The map saved (the current one) is first adjusted as a whole (a global BA with the
+  // ba.requested_* bounds), in this thread. Off: the TartanAir runs relocalising in a map
+  // saved so did worse from two of three starts (README).
+  bool map_save_global_ba = false;
   // Relocalisation (issue 6: "relocalise against the existing map when the camera
   // returns"). Each keyframe describes the points its tracks observe (ORB at the track's
   // position, oriented, full resolution; the point keeps its latest keyframe's
@@ -355,7 +360,8 @@ struct SlamOptions {
     MBSLAM_CHECK_OPTION(reloc_ratio > 0.0 && reloc_ratio <= 1.0);
     MBSLAM_CHECK_OPTION_GE(reloc_min_inliers, 6);
     MBSLAM_CHECK_OPTION_GT(reloc_ransac_iterations, 0);
-    MBSLAM_CHECK_OPTION(reloc_search_radius_px == 0.0 || reloc_search_radius_px >= 1.0);
+    MBSLAM_CHECK_OPTION(reloc_search_radius_px == 0.0 ||
+                        (reloc_search_radius_px >= 1.0 && std::isfinite(reloc_search_radius_px)));
     MBSLAM_CHECK_OPTION_GE(reloc_seed_inliers, 6);
     MBSLAM_CHECK_OPTION(reloc_patch_px >= 5 && reloc_patch_px % 2 == 1);
     MBSLAM_CHECK_OPTION_GE(reloc_loaded_max_frames, 0);
@@ -490,6 +496,8 @@ struct SlamOptions {
       "afterwards (no longer static, or drifted off it)");
     v("map_load_path", &map_load_path, "map loaded at start (\"\" = none)");
     v("map_save_path", &map_save_path, "map saved at exit (\"\" = none)");
+    v("map_save_global_ba", &map_save_global_ba,
+      "the map saved at exit is first adjusted as a whole (global BA, ba.requested_* bounds)");
     v("relocalization", &relocalization,
       "an image the map's tracks cannot place is matched against the map points' ORB "
       "descriptors (kept at keyframes) and resected on them; also how a loaded map is found again");
@@ -692,6 +700,8 @@ class SlamSystem {
   };
   const RefineStats& refine_stats() const { return refine_stats_; }
   double last_ba_seconds() const { return last_ba_seconds_; }
+  // The last adjustment merged was a global one asked for (RequestGlobalBundleAdjustment).
+  bool last_ba_requested() const { return last_ba_requested_; }
   // Images placed by relocalisation (SlamOptions::relocalization) so far.
   int64_t relocalizations() const { return relocalizations_; }
   // Kept lost maps taken up again (SlamOptions::lost_maps_kept) so far, and kept now.
@@ -763,7 +773,8 @@ class SlamSystem {
   bool NeedKeyframe(const SlamFrame& frame, const std::unordered_map<int64_t, int>& labels) const;
   // A local BA (global: over the whole map when it is small), or the global BA asked for
   // (requested: the whole map, with the requested_* solver bounds).
-  void StartBundleAdjustment(bool global, bool requested = false);
+  // here_and_now: in this thread, whatever background_ba says (the map about to be saved).
+  void StartBundleAdjustment(bool global, bool requested = false, bool here_and_now = false);
   // ExtractBaProblem with this SLAM's rotation prior settings.
   BaProblem ExtractBa(int window, bool global, double focal_px, bool use_odometry) const;
   // The rotation prior of `frame` against the last keyframe with one of the same
@@ -976,6 +987,9 @@ class SlamSystem {
   std::unique_ptr<BaProblem> ba_problem_;
   BaSummary ba_summary_;
   int64_t ba_runs_ = 0;
+  bool last_ba_usable_ = false;
+  bool last_ba_requested_ = false;
+  bool running_ba_requested_ = false;  // the adjustment in the back end was asked for
   bool global_ba_requested_ = false;
   int64_t requested_ba_runs_ = 0;
   double last_ba_seconds_ = 0.0;

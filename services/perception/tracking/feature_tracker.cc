@@ -618,6 +618,7 @@ void FeatureTracker::MatchByDescriptors(const cv::Mat& prev_image, const cv::Mat
   // Each lost track (by surviving keypoint) matched among the keypoints near it.
   const auto described = [](const std::vector<cv::KeyPoint>& k, const cv::Mat& d,
                             std::vector<Eigen::Vector2f>* uv, std::vector<OrbDescriptor>* out) {
+    if (d.type() != CV_8UC1 || d.cols != static_cast<int>(OrbDescriptor().bits.size())) return;
     for (int r = 0; r < d.rows && r < static_cast<int>(k.size()); ++r) {
       uv->emplace_back(k[static_cast<size_t>(r)].pt.x, k[static_cast<size_t>(r)].pt.y);
       out->emplace_back();

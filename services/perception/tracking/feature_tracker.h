@@ -9,6 +9,7 @@
 // they reappear), and affine patch warps when the pose is known (tracks re-aligned on
 // their reference appearance warped into the new view, against KLT's drift).
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <unordered_map>
@@ -164,7 +165,7 @@ struct TrackerOptions {
     MBSLAM_CHECK_OPTION_GT(fallback_features, 0);
     MBSLAM_CHECK_OPTION(fallback_max_hamming > 0 && fallback_max_hamming <= 256);
     MBSLAM_CHECK_OPTION(fallback_ratio > 0.0 && fallback_ratio <= 1.0);
-    MBSLAM_CHECK_OPTION_GT(fallback_radius, 0.0);
+    MBSLAM_CHECK_OPTION(fallback_radius > 0.0 && std::isfinite(fallback_radius));
     MBSLAM_CHECK_OPTION(glitch_max_survival >= 0.0 && glitch_max_survival < 1.0);
     MBSLAM_CHECK_OPTION_GE(glitch_min_tracks, 1);
     MBSLAM_CHECK_OPTION_GE(exposure_min_mean_change, 0.0);

@@ -241,12 +241,16 @@ std::vector<std::pair<int, int>> MatchOrbWithinRadius(const std::vector<Eigen::V
     }
   };
   std::unordered_map<std::pair<int64_t, int64_t>, std::vector<int>, CellHash> grid;
+  // Positions this far out are no image's (and their cell index would overflow).
+  const auto usable = [](const Eigen::Vector2f& uv) {
+    return uv.allFinite() && uv.cwiseAbs().maxCoeff() < 1e9f;
+  };
   for (size_t j = 0; j < nt; ++j) {
-    if (!train_uv[j].allFinite()) continue;
+    if (!usable(train_uv[j])) continue;
     grid[cell_of(train_uv[j].x(), train_uv[j].y())].push_back(static_cast<int>(j));
   }
   for (size_t i = 0; i < nq; ++i) {
-    if (!query_uv[i].allFinite()) continue;
+    if (!usable(query_uv[i])) continue;
     const Eigen::Vector2d uv = query_uv[i].cast<double>();
     const auto [cu, cv] = cell_of(uv.x(), uv.y());
     for (int64_t du = -1; du <= 1; ++du) {

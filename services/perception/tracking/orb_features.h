@@ -56,7 +56,9 @@ std::vector<std::pair<int, int>> MatchOrb(const std::vector<OrbDescriptor>& quer
 // One-to-one matches (query index, train index) of queries with a predicted position:
 // the same test as MatchOrb, but each query is compared only with the train points
 // within radius_px of query_uv (a track's last position, a map point's projection).
-// Queries whose position is not finite are skipped. In query order.
+// Queries and train points whose position is not finite are skipped; radius_px must be
+// positive and finite (else no match). The shorter of each position / descriptor pair of
+// vectors counts. In query order.
 std::vector<std::pair<int, int>> MatchOrbWithinRadius(const std::vector<Eigen::Vector2f>& query_uv,
                                                       const std::vector<OrbDescriptor>& query,
                                                       const std::vector<Eigen::Vector2f>& train_uv,

@@ -86,11 +86,31 @@ TEST(OrbFeatures, MatchOrbWithinRadiusComparesOnlyTheTrainPointsNearEachQuery) {
   EXPECT_EQ(MatchOrbWithinRadius({V(100, 100), V(101, 100)}, {qa, qa_far}, train_uv, train, 20.0,
                                  50, 0.8),
             (std::vector<std::pair<int, int>>{{0, 0}}));
+  // Two queries equally near one train point in bits: the first keeps it, in both matchers.
+  EXPECT_EQ(
+      MatchOrbWithinRadius({V(100, 100), V(101, 100)}, {qa, qa}, train_uv, train, 20.0, 50, 0.8),
+      (std::vector<std::pair<int, int>>{{0, 0}}));
+  EXPECT_EQ(MatchOrb({qa, qa}, {a, b}, 50, 0.8), (std::vector<std::pair<int, int>>{{0, 0}}));
+  // The ratio test's boundary: 4 bits against 5 passes at 0.8 (b1 <= 0.8 b2), in both.
+  const OrbDescriptor four = Bits({0, 1, 2, 3, 4, 5, 6, 7, 8, 20, 21, 22, 23});
+  const OrbDescriptor five = Bits({0, 1, 2, 3, 4, 5, 6, 7, 8, 30, 31, 32, 33, 34});
+  EXPECT_EQ(MatchOrbWithinRadius({V(102, 100)}, {qa}, two_uv, {four, five}, 20.0, 50, 0.8).size(),
+            1u);
+  EXPECT_EQ(MatchOrb({qa}, {four, five}, 50, 0.8).size(), 1u);
+  // The cells cover the radius: 19 px apart across a cell boundary, and at negative
+  // coordinates.
+  EXPECT_EQ(MatchOrbWithinRadius({V(100, 100)}, {qa}, {V(81, 100)}, {a}, 20.0, 50, 0.8).size(), 1u);
+  EXPECT_EQ(MatchOrbWithinRadius({V(-1, 0)}, {qa}, {V(-20.5, 0)}, {a}, 20.0, 50, 0.8).size(), 1u);
+  EXPECT_EQ(MatchOrbWithinRadius({V(-1, -1)}, {qa}, {V(-19, -1)}, {a}, 20.0, 50, 0.8).size(), 1u);
   // The distance limit, a query without a position, and degenerate radii.
   EXPECT_TRUE(MatchOrbWithinRadius({V(104, 100)}, {qa}, train_uv, train, 20.0, 0, 0.8).empty());
   EXPECT_TRUE(MatchOrbWithinRadius({V(NAN, 100)}, {qa}, train_uv, train, 20.0, 50, 0.8).empty());
   EXPECT_TRUE(MatchOrbWithinRadius({V(104, 100)}, {qa}, train_uv, train, 0.0, 50, 0.8).empty());
   EXPECT_TRUE(MatchOrbWithinRadius({V(104, 100)}, {qa}, {}, {}, 20.0, 50, 0.8).empty());
+  EXPECT_TRUE(
+      MatchOrbWithinRadius({V(104, 100)}, {qa}, train_uv, train, INFINITY, 50, 0.8).empty());
+  EXPECT_TRUE(
+      MatchOrbWithinRadius({V(3e9f, 100)}, {qa}, {V(3e9f, 100)}, {a}, 20.0, 50, 0.8).empty());
 }
 
 TEST(OrbFeatures, GivenPointsAreDescribedAsDetectedOnes) {
